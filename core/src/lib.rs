@@ -1,0 +1,12 @@
+//! # lodestone-core
+//!
+//! All of Lodestone's math and its material model, with no GPU and no UI. Every formula lives here
+//! once, with the paper and equation it implements in its doc comment; the WGSL in
+//! `lodestone-render` mirrors the f32 functions of this crate under the same names.
+//!
+//! Papers (plain text in `../shared/papers/`):
+//! * [HN12] Heitz, Neyret. *Representing Appearance and Pre-filtering Subpixel Data in Sparse Voxel Octrees.* HPG 2012.
+//! * [HNPN14] Heitz, Nowrouzezahrai, Poulin, Neyret. *Filtering Non-Linear Transfer Functions on Surfaces.* TVCG 2014.
+
+pub mod special;
+pub mod special_f32;
