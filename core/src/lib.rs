@@ -10,3 +10,9 @@
 
 pub mod special;
 pub mod special_f32;
+pub mod attribute;
+pub mod effective_height;
+pub mod quadrature;
+pub mod shadowing;
+pub mod slopes;
+pub mod smith;
