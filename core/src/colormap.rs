@@ -231,7 +231,7 @@ impl Gradient {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::special::norm_cdf;
 

@@ -17,6 +17,7 @@ pub mod quadrature;
 pub mod shadowing;
 pub mod slopes;
 pub mod smith;
+pub mod transfer;
 pub mod colormap;
 pub mod preconvolved;
 pub mod validation;
