@@ -12,6 +12,8 @@ pub mod special;
 pub mod special_f32;
 pub mod attribute;
 pub mod effective_height;
+pub mod image_driver;
+pub mod noise;
 pub mod piecewise;
 pub mod quadrature;
 pub mod shadowing;
