@@ -25,6 +25,7 @@ pub enum Interpolation {
 
 /// One gradient stop.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct ColorStop {
     /// Position along the mapped scalar.
     pub position: f64,
@@ -34,6 +35,7 @@ pub struct ColorStop {
 
 /// A colour gradient.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Gradient {
     /// Stops sorted by position (equal positions make a hard edge).
     pub stops: Vec<ColorStop>,

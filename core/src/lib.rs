@@ -11,6 +11,7 @@
 pub mod special;
 pub mod special_f32;
 pub mod attribute;
+pub mod brdf;
 pub mod effective_height;
 pub mod image_driver;
 pub mod noise;
@@ -21,5 +22,6 @@ pub mod slopes;
 pub mod smith;
 pub mod transfer;
 pub mod colormap;
+pub mod material;
 pub mod preconvolved;
 pub mod validation;

@@ -21,6 +21,7 @@ use std::f64::consts::{PI, TAU};
 
 /// Parameters of the sum-of-sinusoids noise.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 #[serde(default)]
 pub struct NoiseParams {
     /// Random seed.

@@ -21,6 +21,7 @@ pub const MARGIN_SIGMAS: f64 = 4.0;
 
 /// Size and σ range of a pre-convolved table.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct TableSpec {
     /// Texels along the mean axis (≥ 2).
     pub size_m: usize,

@@ -26,6 +26,7 @@ pub enum CurveInterpolation {
 /// A curve `g` through control points `(f, g)`, constant beyond the first and last point.
 /// Two points with the same `f` make a vertical segment (a cliff in the surface).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Curve {
     /// Control points `[f, g]`, sorted by f.
     pub points: Vec<[f64; 2]>,
