@@ -9,10 +9,12 @@
 //! * [HNPN14] Heitz, Nowrouzezahrai, Poulin, Neyret. *Filtering Non-Linear Transfer Functions on Surfaces.* TVCG 2014.
 
 pub mod special;
+pub mod surface;
 pub mod special_f32;
 pub mod attribute;
 pub mod brdf;
 pub mod effective_height;
+pub mod footprint;
 pub mod image_driver;
 pub mod noise;
 pub mod piecewise;
