@@ -42,7 +42,11 @@ mod tests {
             let num = integrate(|t| attribute_shape(t) * w(t), -12.0, 16.0, 3000);
             let den = integrate(w, -12.0, 16.0, 3000);
             let want = num / den;
-            assert!((mean_attribute_shape(l) - want).abs() < 1e-9, "L={l}: {} vs {want}", mean_attribute_shape(l));
+            assert!(
+                (mean_attribute_shape(l) - want).abs() < 1e-9,
+                "L={l}: {} vs {want}",
+                mean_attribute_shape(l)
+            );
         }
     }
 

@@ -31,7 +31,11 @@ pub struct BaseBrdf {
 
 impl Default for BaseBrdf {
     fn default() -> Self {
-        Self { albedo: 1.0, specular: 0.0, roughness: 0.2 }
+        Self {
+            albedo: 1.0,
+            specular: 0.0,
+            roughness: 0.2,
+        }
     }
 }
 
@@ -63,7 +67,12 @@ impl BaseBrdf {
     /// Specular part for a facet of normal n (see the module docs); `extra` is an added slope
     /// covariance (the unresolved slopes of the filtered model; zero for an explicit facet).
     pub fn specular_with(&self, n: DVec3, wo: DVec3, wi: DVec3, extra: SlopeCov) -> f64 {
-        if self.specular <= 0.0 || n.dot(wi) <= 0.0 || n.dot(wo) <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0 {
+        if self.specular <= 0.0
+            || n.dot(wi) <= 0.0
+            || n.dot(wo) <= 0.0
+            || wo.z <= 0.0
+            || wi.z <= 0.0
+        {
             return 0.0;
         }
         let h = (wo + wi).normalize();
@@ -91,16 +100,27 @@ mod tests {
 
     #[test]
     fn lambert_reflects_albedo_over_pi() {
-        let b = BaseBrdf { albedo: 0.8, specular: 0.0, roughness: 0.1 };
+        let b = BaseBrdf {
+            albedo: 0.8,
+            specular: 0.0,
+            roughness: 0.1,
+        };
         let wi = DVec3::new(0.6, 0.0, 0.8);
         assert!((b.diffuse(DVec3::Z, wi) - 0.8 * 0.8 / std::f64::consts::PI).abs() < 1e-15);
-        assert_eq!(b.diffuse(DVec3::Z, DVec3::new(1.0, 0.0, -0.1).normalize()), 0.0);
+        assert_eq!(
+            b.diffuse(DVec3::Z, DVec3::new(1.0, 0.0, -0.1).normalize()),
+            0.0
+        );
     }
 
     #[test]
     fn averaging_facets_widens_the_lobe() {
         // E_{s_n ~ N(0, Σ)}[N(s_h − s_n; σ0²)] = N(s_h; Σ + σ0²): checked by 2D Gauss–Hermite.
-        let b = BaseBrdf { albedo: 0.0, specular: 1.0, roughness: 0.15 };
+        let b = BaseBrdf {
+            albedo: 0.0,
+            specular: 1.0,
+            roughness: 0.15,
+        };
         let sigma = SlopeCov::from_std(0.2, 0.1);
         let wo = DVec3::new(0.3, 0.1, 0.9).normalize();
         let wi = DVec3::new(-0.2, 0.25, 0.8).normalize();

@@ -46,13 +46,21 @@ pub struct Gradient {
 
 /// sRGB transfer → linear (IEC 61966-2-1).
 pub fn srgb_to_linear(c: f64) -> f64 {
-    if c <= 0.040_45 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+    if c <= 0.040_45 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
 }
 
 /// Linear → sRGB transfer (IEC 61966-2-1); input clamped to [0, 1].
 pub fn linear_to_srgb(c: f64) -> f64 {
     let c = if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) };
-    if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+    if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
 }
 
 impl Gradient {
@@ -67,13 +75,25 @@ impl Gradient {
                 color: c.map(|v| srgb_to_linear(f64::from(v) / 255.0)),
             })
             .collect();
-        Self { stops, interpolation }
+        Self {
+            stops,
+            interpolation,
+        }
     }
 
     /// Two-stop linear gradient.
     pub fn two(lo: f64, c0: [f64; 3], hi: f64, c1: [f64; 3]) -> Self {
         Self {
-            stops: vec![ColorStop { position: lo, color: c0 }, ColorStop { position: hi, color: c1 }],
+            stops: vec![
+                ColorStop {
+                    position: lo,
+                    color: c0,
+                },
+                ColorStop {
+                    position: hi,
+                    color: c1,
+                },
+            ],
             interpolation: Interpolation::Linear,
         }
     }
@@ -102,7 +122,14 @@ impl Gradient {
     /// A terrain map: deep water, shore, grass, rock, snow, over [lo, hi].
     pub fn terrain(lo: f64, hi: f64) -> Self {
         Self::from_srgb8(
-            &[[0x1d, 0x3c, 0x6e], [0x3f, 0x86, 0xc2], [0xd9, 0xc8, 0x8c], [0x4f, 0x8a, 0x3b], [0x7a, 0x6a, 0x55], [0xf4, 0xf4, 0xf6]],
+            &[
+                [0x1d, 0x3c, 0x6e],
+                [0x3f, 0x86, 0xc2],
+                [0xd9, 0xc8, 0x8c],
+                [0x4f, 0x8a, 0x3b],
+                [0x7a, 0x6a, 0x55],
+                [0xf4, 0xf4, 0xf6],
+            ],
             lo,
             hi,
             Interpolation::Smooth,
@@ -111,7 +138,17 @@ impl Gradient {
 
     /// Rust in the crevices: dark orange-brown low, bare grey metal high, over [lo, hi].
     pub fn rust(lo: f64, hi: f64) -> Self {
-        Self::from_srgb8(&[[0x5a, 0x22, 0x0b], [0xa3, 0x4a, 0x17], [0x8c, 0x80, 0x76], [0xb4, 0xb6, 0xb8]], lo, hi, Interpolation::Smooth)
+        Self::from_srgb8(
+            &[
+                [0x5a, 0x22, 0x0b],
+                [0xa3, 0x4a, 0x17],
+                [0x8c, 0x80, 0x76],
+                [0xb4, 0xb6, 0xb8],
+            ],
+            lo,
+            hi,
+            Interpolation::Smooth,
+        )
     }
 
     /// Colour at x (constant beyond the end stops). An empty gradient is black.
@@ -187,8 +224,19 @@ impl Gradient {
     /// Reverse the gradient (positions mirrored within its range).
     pub fn flipped(&self) -> Self {
         let (lo, hi) = self.range();
-        let stops = self.stops.iter().rev().map(|s| ColorStop { position: lo + hi - s.position, color: s.color }).collect();
-        Self { stops, interpolation: self.interpolation }
+        let stops = self
+            .stops
+            .iter()
+            .rev()
+            .map(|s| ColorStop {
+                position: lo + hi - s.position,
+                color: s.color,
+            })
+            .collect();
+        Self {
+            stops,
+            interpolation: self.interpolation,
+        }
     }
 
     /// Spread the stops evenly over the current range, keeping their order and colours.
@@ -199,16 +247,25 @@ impl Gradient {
             .stops
             .iter()
             .enumerate()
-            .map(|(i, s)| ColorStop { position: lo + (hi - lo) * i as f64 / n as f64, color: s.color })
+            .map(|(i, s)| ColorStop {
+                position: lo + (hi - lo) * i as f64 / n as f64,
+                color: s.color,
+            })
             .collect();
-        Self { stops, interpolation: self.interpolation }
+        Self {
+            stops,
+            interpolation: self.interpolation,
+        }
     }
 
     /// Record every problem: no stops, non-finite positions or colours, unsorted positions,
     /// negative colour components.
     pub fn validate(&self, field: &str, problems: &mut Problems) {
         if self.stops.is_empty() {
-            problems.push(format!("{field}.stops"), "a gradient needs at least one stop");
+            problems.push(
+                format!("{field}.stops"),
+                "a gradient needs at least one stop",
+            );
         }
         for (i, s) in self.stops.iter().enumerate() {
             problems.finite(&format!("{field}.stops[{i}].position"), s.position);
@@ -225,7 +282,10 @@ impl Gradient {
             if w[1].position < w[0].position {
                 problems.push(
                     format!("{field}.stops[{}].position", i + 1),
-                    format!("stops must be sorted by position: {} comes after {}", w[1].position, w[0].position),
+                    format!(
+                        "stops must be sorted by position: {} comes after {}",
+                        w[1].position, w[0].position
+                    ),
                 );
             }
         }
@@ -260,7 +320,16 @@ pub(crate) mod tests {
     #[test]
     fn step_map_is_a_normal_cdf() {
         let g = Gradient {
-            stops: vec![ColorStop { position: -0.5, color: [0.2, 0.0, 1.0] }, ColorStop { position: 0.4, color: [0.9, 0.5, 0.0] }],
+            stops: vec![
+                ColorStop {
+                    position: -0.5,
+                    color: [0.2, 0.0, 1.0],
+                },
+                ColorStop {
+                    position: 0.4,
+                    color: [0.9, 0.5, 0.0],
+                },
+            ],
             interpolation: Interpolation::Constant,
         };
         for &(m, s) in &[(0.0, 0.3), (0.4, 0.01), (1.2, 0.5), (-2.0, 1.0)] {
@@ -304,7 +373,11 @@ pub(crate) mod tests {
             for ch in 0..3 {
                 let mean = acc[ch] / n as f64;
                 let se = ((acc2[ch] / n as f64 - mean * mean) / n as f64).sqrt();
-                assert!((got[ch] - mean).abs() < 4.0 * se + 5e-4, "m={m} σ={s} ch={ch}: {} vs {mean} ± {se}", got[ch]);
+                assert!(
+                    (got[ch] - mean).abs() < 4.0 * se + 5e-4,
+                    "m={m} σ={s} ch={ch}: {} vs {mean} ± {se}",
+                    got[ch]
+                );
             }
         }
     }
@@ -330,7 +403,10 @@ pub(crate) mod tests {
                     }
                 }
             }
-            assert!(worst < bound, "σ ∈ [{lo}, {hi}]: bilinear interpolation error {worst}");
+            assert!(
+                worst < bound,
+                "σ ∈ [{lo}, {hi}]: bilinear interpolation error {worst}"
+            );
             eprintln!("viridis 256×256 table, σ ∈ [{lo}, {hi}]: worst bilinear error {worst:.2e}");
         }
         let _ = spec;
@@ -340,9 +416,18 @@ pub(crate) mod tests {
     fn validation_reports_every_problem() {
         let g = Gradient {
             stops: vec![
-                ColorStop { position: 0.5, color: [f64::NAN, 0.0, -1.0] },
-                ColorStop { position: 0.1, color: [0.0; 3] },
-                ColorStop { position: f64::INFINITY, color: [0.0; 3] },
+                ColorStop {
+                    position: 0.5,
+                    color: [f64::NAN, 0.0, -1.0],
+                },
+                ColorStop {
+                    position: 0.1,
+                    color: [0.0; 3],
+                },
+                ColorStop {
+                    position: f64::INFINITY,
+                    color: [0.0; 3],
+                },
             ],
             interpolation: Interpolation::Linear,
         };
@@ -354,7 +439,11 @@ pub(crate) mod tests {
         assert!(fields.contains(&"color.stops[1].position"));
         assert!(fields.contains(&"color.stops[2].position"));
         let mut p = Problems::default();
-        Gradient { stops: vec![], interpolation: Interpolation::Smooth }.validate("c", &mut p);
+        Gradient {
+            stops: vec![],
+            interpolation: Interpolation::Smooth,
+        }
+        .validate("c", &mut p);
         assert_eq!(p.0.len(), 1);
     }
 

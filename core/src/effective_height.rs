@@ -50,7 +50,11 @@ fn rule() -> &'static Rule {
     RULE.get_or_init(|| {
         let (x, w) = crate::quadrature::gl8();
         let h = (T_HI - T_LO) / PANELS as f64;
-        let mut r = Rule { t: vec![], w_phi: vec![], log_cdf: vec![] };
+        let mut r = Rule {
+            t: vec![],
+            w_phi: vec![],
+            log_cdf: vec![],
+        };
         for p in 0..PANELS {
             let c = T_LO + (p as f64 + 0.5) * h;
             for (xi, wi) in x.iter().zip(w) {
@@ -70,21 +74,37 @@ pub fn exact_moments(l: f64) -> HeightMoments {
     let l = if l.is_nan() { 0.0 } else { l.clamp(0.0, 1e12) };
     let r = rule();
     let (mut z, mut m1) = (0.0, 0.0);
-    let weights: Vec<f64> = r.log_cdf.iter().zip(&r.w_phi).map(|(lc, w)| w * (l * lc).exp()).collect();
+    let weights: Vec<f64> = r
+        .log_cdf
+        .iter()
+        .zip(&r.w_phi)
+        .map(|(lc, w)| w * (l * lc).exp())
+        .collect();
     for (w, t) in weights.iter().zip(&r.t) {
         z += w;
         m1 += w * t;
     }
     let mean = m1 / z;
-    let var: f64 = weights.iter().zip(&r.t).map(|(w, t)| w * (t - mean) * (t - mean)).sum::<f64>() / z;
-    HeightMoments { mean, std: var.sqrt() }
+    let var: f64 = weights
+        .iter()
+        .zip(&r.t)
+        .map(|(w, t)| w * (t - mean) * (t - mean))
+        .sum::<f64>()
+        / z;
+    HeightMoments {
+        mean,
+        std: var.sqrt(),
+    }
 }
 
 /// The paper's fits [HNPN14 Eqs. 16–17]: `μ_d = 0.39 ln(4.75 L + 1)`,
 /// `σ_d = 1/(1 + 0.26 ln(1.13 L + 1))` (standardized). L is clamped to [0, 1e30]: always finite.
 pub fn paper_fit_moments(l: f64) -> HeightMoments {
     let l = if l.is_nan() { 0.0 } else { l.clamp(0.0, 1e30) };
-    HeightMoments { mean: 0.39 * (4.75 * l).ln_1p(), std: 1.0 / (1.0 + 0.26 * (1.13 * l).ln_1p()) }
+    HeightMoments {
+        mean: 0.39 * (4.75 * l).ln_1p(),
+        std: 1.0 / (1.0 + 0.26 * (1.13 * l).ln_1p()),
+    }
 }
 
 /// Exact D_h moments tabulated over ln L with linear interpolation (the GPU samples the same table
@@ -119,7 +139,12 @@ impl EffectiveHeightTable {
             mean.push(m.mean);
             std.push(m.std);
         }
-        Self { ln_l_min: a, ln_l_max: b, mean, std }
+        Self {
+            ln_l_min: a,
+            ln_l_max: b,
+            mean,
+            std,
+        }
     }
 
     /// The shared default table (built once, ~20 ms).
@@ -135,9 +160,13 @@ impl EffectiveHeightTable {
         let l_min = self.ln_l_min.exp();
         if l < l_min {
             let s = l / l_min;
-            return HeightMoments { mean: s * self.mean[0], std: 1.0 + s * (self.std[0] - 1.0) };
+            return HeightMoments {
+                mean: s * self.mean[0],
+                std: 1.0 + s * (self.std[0] - 1.0),
+            };
         }
-        let u = ((l.ln() - self.ln_l_min) / (self.ln_l_max - self.ln_l_min) * (n - 1) as f64).clamp(0.0, (n - 1) as f64);
+        let u = ((l.ln() - self.ln_l_min) / (self.ln_l_max - self.ln_l_min) * (n - 1) as f64)
+            .clamp(0.0, (n - 1) as f64);
         let i = (u.floor() as usize).min(n - 2);
         let f = u - i as f64;
         HeightMoments {
@@ -166,12 +195,24 @@ mod tests {
         // (L, mean, variance) of the max of L+1 standard normals (closed forms and Tippett's values).
         let cases = [
             (1.0, 1.0 / sqrt_pi, 1.0 - 1.0 / PI),
-            (2.0, 1.5 / sqrt_pi, 1.0 + 3f64.sqrt() / (2.0 * PI) - 9.0 / (4.0 * PI)),
+            (
+                2.0,
+                1.5 / sqrt_pi,
+                1.0 + 3f64.sqrt() / (2.0 * PI) - 9.0 / (4.0 * PI),
+            ),
         ];
         for (l, mean, var) in cases {
             let m = exact_moments(l);
-            assert!((m.mean - mean).abs() < 1e-12, "L={l}: mean {} vs {mean}", m.mean);
-            assert!((m.std * m.std - var).abs() < 1e-12, "L={l}: var {} vs {var}", m.std * m.std);
+            assert!(
+                (m.mean - mean).abs() < 1e-12,
+                "L={l}: mean {} vs {mean}",
+                m.mean
+            );
+            assert!(
+                (m.std * m.std - var).abs() < 1e-12,
+                "L={l}: var {} vs {var}",
+                m.std * m.std
+            );
         }
         assert!((exact_moments(3.0).mean - 1.029_375_373_0).abs() < 1e-9);
         assert!((exact_moments(4.0).mean - 1.162_964_473_6).abs() < 1e-9);
@@ -184,8 +225,17 @@ mod tests {
     fn normalisation_is_one_over_l_plus_one() {
         let r = rule();
         for l in [0.5, 7.0, 1e3, 1e6, 1e12] {
-            let z: f64 = r.log_cdf.iter().zip(&r.w_phi).map(|(lc, w)| w * (l * lc).exp()).sum();
-            assert!(((z * (l + 1.0)) - 1.0).abs() < 1e-11, "L={l}: {}", z * (l + 1.0));
+            let z: f64 = r
+                .log_cdf
+                .iter()
+                .zip(&r.w_phi)
+                .map(|(lc, w)| w * (l * lc).exp())
+                .sum();
+            assert!(
+                ((z * (l + 1.0)) - 1.0).abs() < 1e-11,
+                "L={l}: {}",
+                z * (l + 1.0)
+            );
         }
     }
 
@@ -195,16 +245,21 @@ mod tests {
         let mut worst: f64 = 0.0;
         // Midpoints between entries are where linear interpolation is worst; sample densely.
         for k in 0..2000 {
-            let ln_l = (1e-6f64).ln() + ((1e6f64).ln() - (1e-6f64).ln()) * (k as f64 + 0.37) / 2000.0;
+            let ln_l =
+                (1e-6f64).ln() + ((1e6f64).ln() - (1e-6f64).ln()) * (k as f64 + 0.37) / 2000.0;
             let l = ln_l.exp();
             let e = exact_moments(l);
             let t = table.lookup(l);
-            worst = worst.max((e.mean - t.mean).abs()).max((e.std - t.std).abs());
+            worst = worst
+                .max((e.mean - t.mean).abs())
+                .max((e.std - t.std).abs());
         }
         for l in [0.0, 1e-9, 1e-7, 5e-7] {
             let e = exact_moments(l);
             let t = table.lookup(l);
-            worst = worst.max((e.mean - t.mean).abs()).max((e.std - t.std).abs());
+            worst = worst
+                .max((e.mean - t.mean).abs())
+                .max((e.std - t.std).abs());
         }
         assert!(worst <= 1e-4, "table interpolation error {worst}");
         eprintln!("D_h table worst interpolation error {worst:e} σ_h");
@@ -229,9 +284,27 @@ mod tests {
 
     #[test]
     fn extreme_l_is_finite() {
-        for l in [0.0, 1e-300, 1e-6, 1.0, 1e6, 1e12, 1e20, f64::INFINITY, f64::NAN, -1.0] {
-            for m in [exact_moments(l), paper_fit_moments(l), EffectiveHeightTable::shared().lookup(l)] {
-                assert!(m.mean.is_finite() && m.std.is_finite() && m.std > 0.0, "L={l}: {m:?}");
+        for l in [
+            0.0,
+            1e-300,
+            1e-6,
+            1.0,
+            1e6,
+            1e12,
+            1e20,
+            f64::INFINITY,
+            f64::NAN,
+            -1.0,
+        ] {
+            for m in [
+                exact_moments(l),
+                paper_fit_moments(l),
+                EffectiveHeightTable::shared().lookup(l),
+            ] {
+                assert!(
+                    m.mean.is_finite() && m.std.is_finite() && m.std > 0.0,
+                    "L={l}: {m:?}"
+                );
             }
         }
     }

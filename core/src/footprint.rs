@@ -41,7 +41,9 @@ use std::f64::consts::FRAC_1_PI;
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
 pub enum PrepareError {
     /// Image drivers have no analytic micro-geometry for the CPU ground truth yet.
-    #[error("the CPU evaluator needs a procedural (noise) driver; image drivers are rendered on the GPU only")]
+    #[error(
+        "the CPU evaluator needs a procedural (noise) driver; image drivers are rendered on the GPU only"
+    )]
     ImageDriver,
 }
 
@@ -97,7 +99,10 @@ fn basis(n: DVec3) -> (DVec3, DVec3) {
     let sign = 1f64.copysign(n.z);
     let a = -1.0 / (sign + n.z);
     let b = n.x * n.y * a;
-    (DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x), DVec3::new(b, sign + n.y * n.y * a, -n.y))
+    (
+        DVec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        DVec3::new(b, sign + n.y * n.y * a, -n.y),
+    )
 }
 
 impl Prepared {
@@ -124,7 +129,12 @@ impl Prepared {
         match (&self.material.heights.transfer, &self.transfer_table) {
             (TransferFunction::Curve(_), Some(t)) => {
                 let v = t.sample(m, s);
-                TransferMoments { mean: v[0], std: v[1].max(0.0), mean_deriv: v[2], std_deriv: v[3].max(0.0) }
+                TransferMoments {
+                    mean: v[0],
+                    std: v[1].max(0.0),
+                    mean_deriv: v[2],
+                    std_deriv: v[3].max(0.0),
+                }
             }
             (t, _) => t.moments(m, s),
         }
@@ -133,9 +143,17 @@ impl Prepared {
     fn local(&self, cfg: &Config) -> Local {
         let driver = self.surface.noise.filtered(cfg.x0, cfg.footprint);
         let transfer = self.transfer_moments(driver.mean, driver.std);
-        let stats =
-            transformed_statistics(transfer, self.surface.sigma_h, driver.mean_gradient, driver.gradient_cov);
-        Local { driver, transfer, stats }
+        let stats = transformed_statistics(
+            transfer,
+            self.surface.sigma_h,
+            driver.mean_gradient,
+            driver.gradient_cov,
+        );
+        Local {
+            driver,
+            transfer,
+            stats,
+        }
     }
 
     /// The colour map's input at a point of the explicit surface, and the standardized height there.
@@ -143,7 +161,10 @@ impl Prepared {
         let (gm, gs) = self.g_global;
         let t = (self.material.heights.transfer.eval(f) - gm) / gs;
         match &self.material.color {
-            ColorModel::Gradient { source: ColorSource::Driver, .. } => (f, t),
+            ColorModel::Gradient {
+                source: ColorSource::Driver,
+                ..
+            } => (f, t),
             _ => (t, t),
         }
     }
@@ -164,7 +185,10 @@ impl Prepared {
     fn input_distribution(&self, loc: &Local) -> (f64, f64) {
         let (gm, gs) = self.g_global;
         match &self.material.color {
-            ColorModel::Gradient { source: ColorSource::Driver, .. } => (loc.driver.mean, loc.driver.std),
+            ColorModel::Gradient {
+                source: ColorSource::Driver,
+                ..
+            } => (loc.driver.mean, loc.driver.std),
             _ => ((loc.transfer.mean - gm) / gs, loc.transfer.std / gs),
         }
     }
@@ -173,16 +197,30 @@ impl Prepared {
     /// the pre-convolved table [HNPN14 Eq. 9], or for the attribute model `E[s]` in closed form
     /// `erf(μ/√(2(1+s²)))` corrected by the exact far-field [HN12 Eq. 17] in proportion to the
     /// unresolved variance `w` (exact at both ends of the zoom, smooth in between).
-    fn color_of_distribution(&self, mean: f64, std: f64, l: f64, far: (f64, f64), w: f64) -> [f64; 3] {
+    fn color_of_distribution(
+        &self,
+        mean: f64,
+        std: f64,
+        l: f64,
+        far: (f64, f64),
+        w: f64,
+    ) -> [f64; 3] {
         match (&self.material.color, &self.color_table) {
             (ColorModel::Gradient { .. }, Some(t)) => {
                 let v = t.sample(mean, std);
                 [v[0], v[1], v[2]]
             }
             (ColorModel::Gradient { map, .. }, None) => map.convolved(mean, std),
-            (ColorModel::Attribute { mean: abar, correlation }, _) => {
+            (
+                ColorModel::Attribute {
+                    mean: abar,
+                    correlation,
+                },
+                _,
+            ) => {
                 let gauss = |m: f64, s: f64| erf(m / (2.0 * (1.0 + s * s)).sqrt());
-                let s = gauss(mean, std) + w.clamp(0.0, 1.0) * (mean_attribute_shape(l) - gauss(far.0, far.1));
+                let s = gauss(mean, std)
+                    + w.clamp(0.0, 1.0) * (mean_attribute_shape(l) - gauss(far.0, far.1));
                 [0, 1, 2].map(|c| (abar[c] + correlation[c] * s).max(0.0))
             }
         }
@@ -192,7 +230,10 @@ impl Prepared {
     pub fn naive(&self, cfg: &Config) -> [f64; 3] {
         let loc = self.local(cfg);
         let n = normal_of(loc.stats.slope_mean);
-        self.material.brdf.shade(self.color_at(loc.driver.mean), n, cfg.wo, cfg.wi).map(|v| v * lit(cfg, n))
+        self.material
+            .brdf
+            .shade(self.color_at(loc.driver.mean), n, cfg.wo, cfg.wi)
+            .map(|v| v * lit(cfg, n))
     }
 
     /// View-independent texture filtering: the exact footprint mean colour, shaded like naive.
@@ -201,7 +242,10 @@ impl Prepared {
         let (m, s) = self.input_distribution(&loc);
         let c = self.color_of_distribution(m, s, 0.0, (0.0, 1.0), s * s);
         let n = normal_of(loc.stats.slope_mean);
-        self.material.brdf.shade(c, n, cfg.wo, cfg.wi).map(|v| v * lit(cfg, n))
+        self.material
+            .brdf
+            .shade(c, n, cfg.wo, cfg.wi)
+            .map(|v| v * lit(cfg, n))
     }
 
     /// The filtered model (see the module docs).
@@ -219,10 +263,21 @@ impl Prepared {
         let ms = MaskingShadowing::from_directions(wo, wi, &sigma, f.correlation);
         let hm = height_moments(ms.total, f.height_filter);
         let (m, s) = self.input_distribution(&loc);
-        let color = self.color_of_distribution(m + s * hm.mean, s * hm.std, ms.total, (hm.mean, hm.std), s * s);
-        let vbar = if wi.z > 0.0 && cfg.wi.z > 0.0 { ms.mean_shadowing() } else { 0.0 };
+        let color = self.color_of_distribution(
+            m + s * hm.mean,
+            s * hm.std,
+            ms.total,
+            (hm.mean, hm.std),
+            s * s,
+        );
+        let vbar = if wi.z > 0.0 && cfg.wi.z > 0.0 {
+            ms.mean_shadowing()
+        } else {
+            0.0
+        };
         let brdf = &self.material.brdf;
-        let diffuse = brdf.albedo * FRAC_1_PI * visible_slope_mean(&sigma, wo, |n| n.dot(wi).max(0.0));
+        let diffuse =
+            brdf.albedo * FRAC_1_PI * visible_slope_mean(&sigma, wo, |n| n.dot(wi).max(0.0));
         let spec = filtered_specular(brdf.specular, brdf.roughness, &sigma, wo, wi);
         color.map(|c| vbar * (c * diffuse + spec))
     }
@@ -232,15 +287,24 @@ impl Prepared {
     pub fn ground_truth(&self, cfg: &Config, samples: usize, seed: u64) -> Estimate {
         let samples = samples.max(2);
         if cfg.wo.z <= 0.0 {
-            return Estimate { mean: [0.0; 3], std_error: [0.0; 3], samples };
+            return Estimate {
+                mean: [0.0; 3],
+                std_error: [0.0; 3],
+                samples,
+            };
         }
-        let chol = cholesky(cfg.footprint.cov.x_axis.x, cfg.footprint.cov.x_axis.y, cfg.footprint.cov.y_axis.y);
+        let chol = cholesky(
+            cfg.footprint.cov.x_axis.x,
+            cfg.footprint.cov.x_axis.y,
+            cfg.footprint.cov.y_axis.y,
+        );
         let chunk = 256;
         let chunks = samples.div_ceil(chunk);
         let (sum, sum2) = (0..chunks)
             .into_par_iter()
             .map(|c| {
-                let mut rng = seed ^ (c as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xA076_1D64_78BD_642F;
+                let mut rng =
+                    seed ^ (c as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xA076_1D64_78BD_642F;
                 let mut s = [0.0; 3];
                 let mut s2 = [0.0; 3];
                 for _ in 0..chunk.min(samples - c * chunk) {
@@ -256,12 +320,22 @@ impl Prepared {
             })
             .reduce(
                 || ([0.0; 3], [0.0; 3]),
-                |a, b| ([0, 1, 2].map(|k| a.0[k] + b.0[k]), [0, 1, 2].map(|k| a.1[k] + b.1[k])),
+                |a, b| {
+                    (
+                        [0, 1, 2].map(|k| a.0[k] + b.0[k]),
+                        [0, 1, 2].map(|k| a.1[k] + b.1[k]),
+                    )
+                },
             );
         let n = samples as f64;
         let mean = sum.map(|v| v / n);
-        let std_error = [0, 1, 2].map(|k| ((sum2[k] / n - mean[k] * mean[k]).max(0.0) / (n - 1.0)).sqrt());
-        Estimate { mean, std_error, samples }
+        let std_error =
+            [0, 1, 2].map(|k| ((sum2[k] / n - mean[k] * mean[k]).max(0.0) / (n - 1.0)).sqrt());
+        Estimate {
+            mean,
+            std_error,
+            samples,
+        }
     }
 
     /// One eye ray through the mean-plane point y: its radiance.
@@ -269,20 +343,28 @@ impl Prepared {
         let s = &self.surface;
         let lift = (s.h_max * 1.001 + 1e-9) / cfg.wo.z;
         let o = DVec3::new(y.x, y.y, 0.0) + cfg.wo * lift;
-        let Trace::Hit(t) = s.march(o, -cfg.wo) else { return [0.0; 3] };
+        let Trace::Hit(t) = s.march(o, -cfg.wo) else {
+            return [0.0; 3];
+        };
         let p = o - cfg.wo * t;
         let (f, _h, grad) = s.sample(DVec2::new(p.x, p.y));
         let n = normal_of(grad);
         if n.dot(cfg.wi) <= 0.0 || cfg.wi.z <= 0.0 || !s.sees(p, cfg.wi) {
             return [0.0; 3];
         }
-        self.material.brdf.shade(self.color_at(f), n, cfg.wo, cfg.wi)
+        self.material
+            .brdf
+            .shade(self.color_at(f), n, cfg.wo, cfg.wi)
     }
 }
 
 /// 1 when the light is above the horizon of both the macro surface and the facet n, else 0.
 fn lit(cfg: &Config, n: DVec3) -> f64 {
-    if cfg.wi.z > 0.0 && n.dot(cfg.wi) > 0.0 { 1.0 } else { 0.0 }
+    if cfg.wi.z > 0.0 && n.dot(cfg.wi) > 0.0 {
+        1.0
+    } else {
+        0.0
+    }
 }
 
 /// Lower-triangular Cholesky factor (l11, l21, l22) of [[xx, xy], [xy, yy]]; semi-definite safe.
@@ -366,17 +448,38 @@ mod tests {
     pub(crate) fn gaussian_material() -> Material {
         Material {
             name: "test: Gaussian height-correlated".into(),
-            driver: crate::material::Driver::Noise(NoiseParams { components: 32, ..NoiseParams::default() }),
-            heights: Heights { sigma_h: 0.1, transfer: TransferFunction::Identity },
-            slopes: Slopes { sigma_nx: 0.5, sigma_ny: 0.5 },
-            color: ColorModel::Gradient { map: Gradient::rust(-2.0, 2.0), source: ColorSource::Driver },
-            brdf: BaseBrdf { albedo: 1.0, specular: 0.0, roughness: 0.1 },
+            driver: crate::material::Driver::Noise(NoiseParams {
+                components: 32,
+                ..NoiseParams::default()
+            }),
+            heights: Heights {
+                sigma_h: 0.1,
+                transfer: TransferFunction::Identity,
+            },
+            slopes: Slopes {
+                sigma_nx: 0.5,
+                sigma_ny: 0.5,
+            },
+            color: ColorModel::Gradient {
+                map: Gradient::rust(-2.0, 2.0),
+                source: ColorSource::Driver,
+            },
+            brdf: BaseBrdf {
+                albedo: 1.0,
+                specular: 0.0,
+                roughness: 0.1,
+            },
             ..Material::default()
         }
     }
 
     fn far(wo: DVec3, wi: DVec3) -> Config {
-        Config { wo, wi, x0: DVec2::new(3.0, -7.0), footprint: Footprint::isotropic(40.0) }
+        Config {
+            wo,
+            wi,
+            x0: DVec2::new(3.0, -7.0),
+            footprint: Footprint::isotropic(40.0),
+        }
     }
 
     #[test]
@@ -386,7 +489,10 @@ mod tests {
             let cfg = far(direction(deg.to_radians(), 0.3), DVec3::Z);
             let gt = p.ground_truth(&cfg, 160_000, 17);
             let fi = p.filtered(&cfg);
-            eprintln!("view {deg}°: filtered {fi:.5?}, truth {:.5?} ± {:.5?}", gt.mean, gt.std_error);
+            eprintln!(
+                "view {deg}°: filtered {fi:.5?}, truth {:.5?} ± {:.5?}",
+                gt.mean, gt.std_error
+            );
             for k in 0..3 {
                 let rel = (fi[k] - gt.mean[k]).abs() / gt.mean[k];
                 assert!(
@@ -397,7 +503,11 @@ mod tests {
                     gt.std_error[k],
                     100.0 * rel
                 );
-                assert!(gt.std_error[k] < 0.003 * gt.mean[k], "truth too noisy to judge: {:?}", gt.std_error);
+                assert!(
+                    gt.std_error[k] < 0.003 * gt.mean[k],
+                    "truth too noisy to judge: {:?}",
+                    gt.std_error
+                );
             }
         }
     }
@@ -408,29 +518,47 @@ mod tests {
         // while naive differs (C(f̄) ≠ ⟨C⟩ for a non-linear map).
         let mut m = gaussian_material();
         m.heights.sigma_h = 0.0;
-        m.slopes = Slopes { sigma_nx: 0.0, sigma_ny: 0.0 };
+        m.slopes = Slopes {
+            sigma_nx: 0.0,
+            sigma_ny: 0.0,
+        };
         let p = Prepared::new(&m).unwrap();
-        let cfg = Config { footprint: Footprint::isotropic(5.0), ..far(direction(1.2, 0.0), direction(0.4, 2.0)) };
+        let cfg = Config {
+            footprint: Footprint::isotropic(5.0),
+            ..far(direction(1.2, 0.0), direction(0.4, 2.0))
+        };
         let gt = p.ground_truth(&cfg, 40_000, 3);
         let fi = p.filtered(&cfg);
         let vi = p.view_independent(&cfg);
         let na = p.naive(&cfg);
         for k in 0..3 {
             assert!((fi[k] - vi[k]).abs() < 1e-12);
-            assert!((fi[k] - gt.mean[k]).abs() < 4.0 * gt.std_error[k] + 2e-3 * gt.mean[k], "channel {k}");
+            assert!(
+                (fi[k] - gt.mean[k]).abs() < 4.0 * gt.std_error[k] + 2e-3 * gt.mean[k],
+                "channel {k}"
+            );
         }
-        assert!((na[0] - gt.mean[0]).abs() > 10.0 * gt.std_error[0], "naive should be visibly wrong");
+        assert!(
+            (na[0] - gt.mean[0]).abs() > 10.0 * gt.std_error[0],
+            "naive should be visibly wrong"
+        );
     }
 
     #[test]
     fn close_up_footprint_is_the_geometry() {
         // A footprint far smaller than a feature: all methods shade the local geometry the same.
         let p = Prepared::new(&gaussian_material()).unwrap();
-        let cfg = Config { footprint: Footprint::isotropic(1e-4), ..far(direction(0.5, 0.3), direction(0.3, 1.0)) };
+        let cfg = Config {
+            footprint: Footprint::isotropic(1e-4),
+            ..far(direction(0.5, 0.3), direction(0.3, 1.0))
+        };
         let (na, fi) = (p.naive(&cfg), p.filtered(&cfg));
         for k in 0..3 {
             // Only the colour table's bilinear interpolation separates them.
-            assert!((na[k] - fi[k]).abs() < 5e-3 * na[k] + 2e-5, "{na:?} vs {fi:?}");
+            assert!(
+                (na[k] - fi[k]).abs() < 5e-3 * na[k] + 2e-5,
+                "{na:?} vs {fi:?}"
+            );
         }
     }
 
@@ -444,7 +572,11 @@ mod tests {
             let fi = p.filtered(&cfg);
             let na = p.naive(&cfg);
             let vi = p.view_independent(&cfg);
-            let rel = |a: [f64; 3]| (0..3).map(|k| (a[k] - gt.mean[k]).abs() / gt.mean[k]).fold(0.0, f64::max);
+            let rel = |a: [f64; 3]| {
+                (0..3)
+                    .map(|k| (a[k] - gt.mean[k]).abs() / gt.mean[k])
+                    .fold(0.0, f64::max)
+            };
             eprintln!(
                 "view {deg}°: truth {:.4?} ± {:.4?}; filtered err {:.2}%, view-independent err {:.2}%, naive err {:.2}%",
                 gt.mean,

@@ -71,26 +71,52 @@ impl ImageDriver {
     /// Build from row-major grayscale values.
     pub fn new(width: usize, height: usize, values: &[f32]) -> Result<Self, ImageDriverError> {
         if width == 0 || height == 0 || values.len() != width * height {
-            return Err(ImageDriverError::BadSize { width, height, len: values.len() });
+            return Err(ImageDriverError::BadSize {
+                width,
+                height,
+                len: values.len(),
+            });
         }
         if width > Self::MAX_SIDE || height > Self::MAX_SIDE {
-            return Err(ImageDriverError::TooLarge { width, height, max: Self::MAX_SIDE });
+            return Err(ImageDriverError::TooLarge {
+                width,
+                height,
+                max: Self::MAX_SIDE,
+            });
         }
         if let Some(i) = values.iter().position(|v| !v.is_finite()) {
-            return Err(ImageDriverError::NotFinite { x: i % width, y: i / width });
+            return Err(ImageDriverError::NotFinite {
+                x: i % width,
+                y: i / width,
+            });
         }
         let n = values.len() as f64;
         let mean = values.iter().map(|v| f64::from(*v)).sum::<f64>() / n;
-        let var = values.iter().map(|v| (f64::from(*v) - mean).powi(2)).sum::<f64>() / n;
+        let var = values
+            .iter()
+            .map(|v| (f64::from(*v) - mean).powi(2))
+            .sum::<f64>()
+            / n;
         let std = var.sqrt();
         let scale = if std > 1e-12 { 1.0 / std } else { 0.0 };
-        let base: Vec<f32> = values.iter().map(|v| ((f64::from(*v) - mean) * scale) as f32).collect();
-        let mut levels =
-            vec![MipLevel { width, height, mean_sq: base.iter().map(|v| v * v).collect(), mean: base }];
+        let base: Vec<f32> = values
+            .iter()
+            .map(|v| ((f64::from(*v) - mean) * scale) as f32)
+            .collect();
+        let mut levels = vec![MipLevel {
+            width,
+            height,
+            mean_sq: base.iter().map(|v| v * v).collect(),
+            mean: base,
+        }];
         while let Some(last) = levels.last().filter(|l| l.width > 1 || l.height > 1) {
             levels.push(downsample(last));
         }
-        Ok(Self { levels, original_mean: mean, original_std: std })
+        Ok(Self {
+            levels,
+            original_mean: mean,
+            original_std: std,
+        })
     }
 
     /// Footprint mean and standard deviation at texture coordinate `uv` (wrapping, in units of the
@@ -98,7 +124,11 @@ impl ImageDriver {
     /// moments at `lod = log2(radius)`.
     pub fn filtered(&self, uv: [f64; 2], radius_texels: f64) -> (f64, f64) {
         let max_lod = (self.levels.len() - 1) as f64;
-        let lod = if radius_texels > 1.0 { radius_texels.log2().min(max_lod) } else { 0.0 };
+        let lod = if radius_texels > 1.0 {
+            radius_texels.log2().min(max_lod)
+        } else {
+            0.0
+        };
         let l0 = lod.floor() as usize;
         let l1 = (l0 + 1).min(self.levels.len() - 1);
         let t = lod - l0 as f64;
@@ -131,7 +161,12 @@ fn downsample(l: &MipLevel) -> MipLevel {
             mean_sq[y * w + x] = (b / c) as f32;
         }
     }
-    MipLevel { width: w, height: h, mean, mean_sq }
+    MipLevel {
+        width: w,
+        height: h,
+        mean,
+        mean_sq,
+    }
 }
 
 /// Bilinear, wrapping lookup of both moments; texel centres at (i + ½)/size.
@@ -143,8 +178,14 @@ fn bilinear(l: &MipLevel, uv: [f64; 2]) -> (f64, f64) {
     let wrap = |v: f64, n: usize| (v as i64).rem_euclid(n as i64) as usize;
     let (x0i, y0i) = (wrap(x0, l.width), wrap(y0, l.height));
     let (x1i, y1i) = ((x0i + 1) % l.width, (y0i + 1) % l.height);
-    let at = |x: usize, y: usize| (f64::from(l.mean[y * l.width + x]), f64::from(l.mean_sq[y * l.width + x]));
-    let lerp = |a: (f64, f64), b: (f64, f64), t: f64| (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
+    let at = |x: usize, y: usize| {
+        (
+            f64::from(l.mean[y * l.width + x]),
+            f64::from(l.mean_sq[y * l.width + x]),
+        )
+    };
+    let lerp =
+        |a: (f64, f64), b: (f64, f64), t: f64| (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
     let top = lerp(at(x0i, y0i), at(x1i, y0i), ax);
     let bot = lerp(at(x0i, y1i), at(x1i, y1i), ax);
     lerp(top, bot, ay)
@@ -159,7 +200,9 @@ mod tests {
     fn levels_are_exact_box_statistics() {
         let mut rng = Rng(11);
         let (w, h) = (64, 32);
-        let values: Vec<f32> = (0..w * h).map(|_| (rng.normal() * 2.0 + 5.0) as f32).collect();
+        let values: Vec<f32> = (0..w * h)
+            .map(|_| (rng.normal() * 2.0 + 5.0) as f32)
+            .collect();
         let d = ImageDriver::new(w, h, &values).unwrap();
         assert_eq!(d.levels.len(), 7);
         // Level 3: each texel is the box statistics of an 8×8 block of standardized level 0.
@@ -195,9 +238,21 @@ mod tests {
 
     #[test]
     fn bad_images_are_errors() {
-        assert!(matches!(ImageDriver::new(0, 4, &[]), Err(ImageDriverError::BadSize { .. })));
-        assert!(matches!(ImageDriver::new(2, 2, &[0.0; 3]), Err(ImageDriverError::BadSize { .. })));
-        assert_eq!(ImageDriver::new(2, 1, &[0.0, f32::NAN]), Err(ImageDriverError::NotFinite { x: 1, y: 0 }));
-        assert!(matches!(ImageDriver::new(9000, 1, &vec![0.0; 9000]), Err(ImageDriverError::TooLarge { .. })));
+        assert!(matches!(
+            ImageDriver::new(0, 4, &[]),
+            Err(ImageDriverError::BadSize { .. })
+        ));
+        assert!(matches!(
+            ImageDriver::new(2, 2, &[0.0; 3]),
+            Err(ImageDriverError::BadSize { .. })
+        ));
+        assert_eq!(
+            ImageDriver::new(2, 1, &[0.0, f32::NAN]),
+            Err(ImageDriverError::NotFinite { x: 1, y: 0 })
+        );
+        assert!(matches!(
+            ImageDriver::new(9000, 1, &vec![0.0; 9000]),
+            Err(ImageDriverError::TooLarge { .. })
+        ));
     }
 }

@@ -8,22 +8,22 @@
 //! * [HN12] Heitz, Neyret. *Representing Appearance and Pre-filtering Subpixel Data in Sparse Voxel Octrees.* HPG 2012.
 //! * [HNPN14] Heitz, Nowrouzezahrai, Poulin, Neyret. *Filtering Non-Linear Transfer Functions on Surfaces.* TVCG 2014.
 
-pub mod special;
-pub mod surface;
-pub mod special_f32;
 pub mod attribute;
 pub mod brdf;
+pub mod colormap;
 pub mod effective_height;
 pub mod footprint;
 pub mod image_driver;
+pub mod material;
 pub mod noise;
 pub mod piecewise;
+pub mod preconvolved;
 pub mod quadrature;
 pub mod shadowing;
 pub mod slopes;
 pub mod smith;
+pub mod special;
+pub mod special_f32;
+pub mod surface;
 pub mod transfer;
-pub mod colormap;
-pub mod material;
-pub mod preconvolved;
 pub mod validation;

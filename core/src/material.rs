@@ -139,7 +139,9 @@ pub enum MaterialError {
         message: String,
     },
     /// The preset was written by a newer Lodestone.
-    #[error("preset version {found} is newer than this Lodestone understands ({supported}); update Lodestone")]
+    #[error(
+        "preset version {found} is newer than this Lodestone understands ({supported}); update Lodestone"
+    )]
     TooNew {
         /// Version in the file.
         found: u32,
@@ -158,10 +160,23 @@ impl Default for Material {
             version: MATERIAL_VERSION,
             name: "Rusty bumps".into(),
             driver: Driver::Noise(NoiseParams::default()),
-            heights: Heights { sigma_h: 0.05, transfer: TransferFunction::Identity },
-            slopes: Slopes { sigma_nx: 0.35, sigma_ny: 0.35 },
-            color: ColorModel::Gradient { map: Gradient::rust(-2.0, 2.0), source: ColorSource::Driver },
-            brdf: BaseBrdf { albedo: 1.0, specular: 0.04, roughness: 0.15 },
+            heights: Heights {
+                sigma_h: 0.05,
+                transfer: TransferFunction::Identity,
+            },
+            slopes: Slopes {
+                sigma_nx: 0.35,
+                sigma_ny: 0.35,
+            },
+            color: ColorModel::Gradient {
+                map: Gradient::rust(-2.0, 2.0),
+                source: ColorSource::Driver,
+            },
+            brdf: BaseBrdf {
+                albedo: 1.0,
+                specular: 0.04,
+                roughness: 0.15,
+            },
             filtering: Filtering::default(),
         }
     }
@@ -177,7 +192,10 @@ impl Material {
             message: e.code.to_string(),
         })?;
         if m.version > MATERIAL_VERSION {
-            return Err(MaterialError::TooNew { found: m.version, supported: MATERIAL_VERSION });
+            return Err(MaterialError::TooNew {
+                found: m.version,
+                supported: MATERIAL_VERSION,
+            });
         }
         m.validate().map_err(MaterialError::Invalid)?;
         Ok(m)
@@ -185,8 +203,11 @@ impl Material {
 
     /// Pretty RON.
     pub fn to_ron(&self) -> String {
-        let cfg = ron::ser::PrettyConfig::new().depth_limit(6).struct_names(true);
-        ron::ser::to_string_pretty(self, cfg).unwrap_or_else(|e| format!("// serialisation failed: {e}"))
+        let cfg = ron::ser::PrettyConfig::new()
+            .depth_limit(6)
+            .struct_names(true);
+        ron::ser::to_string_pretty(self, cfg)
+            .unwrap_or_else(|e| format!("// serialisation failed: {e}"))
     }
 
     /// Every invalid field at once (empty = valid).
@@ -200,11 +221,18 @@ impl Material {
                 if n.components == 0 || n.components > NoiseParams::MAX_COMPONENTS {
                     p.push(
                         "driver.components",
-                        format!("must be in 1..={}, got {}", NoiseParams::MAX_COMPONENTS, n.components),
+                        format!(
+                            "must be in 1..={}, got {}",
+                            NoiseParams::MAX_COMPONENTS,
+                            n.components
+                        ),
                     );
                 }
                 if n.octaves == 0 || n.octaves > 12 {
-                    p.push("driver.octaves", format!("must be in 1..=12, got {}", n.octaves));
+                    p.push(
+                        "driver.octaves",
+                        format!("must be in 1..=12, got {}", n.octaves),
+                    );
                 }
                 p.in_range("driver.gain", n.gain, 0.0, 4.0);
                 p.in_range("driver.bandwidth", n.bandwidth, 0.0, 1.5);
@@ -228,7 +256,12 @@ impl Material {
             ColorModel::Attribute { mean, correlation } => {
                 for c in 0..3 {
                     p.in_range(&format!("color.mean[{c}]"), mean[c], 0.0, 1e3);
-                    p.in_range(&format!("color.correlation[{c}]"), correlation[c], -1e3, 1e3);
+                    p.in_range(
+                        &format!("color.correlation[{c}]"),
+                        correlation[c],
+                        -1e3,
+                        1e3,
+                    );
                 }
             }
         }
@@ -238,7 +271,10 @@ impl Material {
         let t = self.filtering.table;
         for (name, v) in [("size_m", t.size_m), ("size_sigma", t.size_sigma)] {
             if !(2..=TableSpec::MAX_SIZE).contains(&v) {
-                p.push(format!("filtering.table.{name}"), format!("must be in 2..={}, got {v}", TableSpec::MAX_SIZE));
+                p.push(
+                    format!("filtering.table.{name}"),
+                    format!("must be in 2..={}, got {v}", TableSpec::MAX_SIZE),
+                );
             }
         }
         p.in_range("filtering.table.sigma_max", t.sigma_max, 1e-3, 100.0);
@@ -252,9 +288,15 @@ impl Material {
 
     /// The noise realisation whose `h = σ_h·f` has this material's σ_h and σ_n; `None` for an image driver.
     pub fn noise(&self) -> Option<SumOfSines> {
-        let Driver::Noise(params) = &self.driver else { return None };
+        let Driver::Noise(params) = &self.driver else {
+            return None;
+        };
         let sh = self.heights.sigma_h;
-        let target = if sh > 0.0 { self.slope_cov().scaled(1.0 / sh.max(1e-12)) } else { SlopeCov::default() };
+        let target = if sh > 0.0 {
+            self.slope_cov().scaled(1.0 / sh.max(1e-12))
+        } else {
+            SlopeCov::default()
+        };
         Some(SumOfSines::new(params, target))
     }
 }
@@ -274,19 +316,34 @@ mod tests {
 
     #[test]
     fn parse_errors_have_line_and_column() {
-        let text = Material::default().to_ron().replacen("sigma_h: 0.05", "sigma_h: oops", 1);
+        let text = Material::default()
+            .to_ron()
+            .replacen("sigma_h: 0.05", "sigma_h: oops", 1);
         match Material::from_ron(&text) {
-            Err(MaterialError::Parse { line, column, .. }) => assert!(line > 1 && column > 1, "{line}:{column}"),
+            Err(MaterialError::Parse { line, column, .. }) => {
+                assert!(line > 1 && column > 1, "{line}:{column}")
+            }
             other => panic!("expected a parse error, got {other:?}"),
         }
-        let unknown = Material::default().to_ron().replacen("sigma_h:", "sigma_hh: 1.0, sigma_h:", 1);
-        assert!(matches!(Material::from_ron(&unknown), Err(MaterialError::Parse { .. })));
+        let unknown =
+            Material::default()
+                .to_ron()
+                .replacen("sigma_h:", "sigma_hh: 1.0, sigma_h:", 1);
+        assert!(matches!(
+            Material::from_ron(&unknown),
+            Err(MaterialError::Parse { .. })
+        ));
     }
 
     #[test]
     fn newer_versions_are_refused() {
-        let text = Material::default().to_ron().replacen("version: 1", "version: 99", 1);
-        assert!(matches!(Material::from_ron(&text), Err(MaterialError::TooNew { found: 99, .. })));
+        let text = Material::default()
+            .to_ron()
+            .replacen("version: 1", "version: 99", 1);
+        assert!(matches!(
+            Material::from_ron(&text),
+            Err(MaterialError::TooNew { found: 99, .. })
+        ));
     }
 
     #[test]
@@ -299,8 +356,14 @@ mod tests {
         m.color = ColorModel::Gradient {
             map: Gradient {
                 stops: vec![
-                    ColorStop { position: 1.0, color: [0.1; 3] },
-                    ColorStop { position: 0.0, color: [0.2; 3] },
+                    ColorStop {
+                        position: 1.0,
+                        color: [0.1; 3],
+                    },
+                    ColorStop {
+                        position: 0.0,
+                        color: [0.2; 3],
+                    },
                 ],
                 interpolation: Interpolation::Linear,
             },
@@ -308,7 +371,13 @@ mod tests {
         };
         let problems = m.validate().unwrap_err();
         let fields: Vec<_> = problems.iter().map(|p| p.field.as_str()).collect();
-        for f in ["heights.sigma_h", "slopes.sigma_nx", "brdf.albedo", "filtering.table.size_m", "color.map.stops[1].position"] {
+        for f in [
+            "heights.sigma_h",
+            "slopes.sigma_nx",
+            "brdf.albedo",
+            "filtering.table.size_m",
+            "color.map.stops[1].position",
+        ] {
             assert!(fields.contains(&f), "{f} missing from {fields:?}");
         }
         assert_eq!(problems.len(), 5);

@@ -41,7 +41,14 @@ pub struct NoiseParams {
 
 impl Default for NoiseParams {
     fn default() -> Self {
-        Self { seed: 1, components: 48, octaves: 3, gain: 0.5, bandwidth: 0.4, frequency: 1.0 }
+        Self {
+            seed: 1,
+            components: 48,
+            octaves: 3,
+            gain: 0.5,
+            bandwidth: 0.4,
+            frequency: 1.0,
+        }
     }
 }
 
@@ -78,7 +85,9 @@ pub struct Footprint {
 impl Footprint {
     /// An isotropic footprint of standard deviation `r` per axis.
     pub fn isotropic(r: f64) -> Self {
-        Self { cov: DMat2::from_diagonal(DVec2::splat(r * r)) }
+        Self {
+            cov: DMat2::from_diagonal(DVec2::splat(r * r)),
+        }
     }
 
     /// A point (no filtering).
@@ -115,7 +124,11 @@ fn sqrt_spd(m: DMat2) -> DMat2 {
     let det = m.determinant().max(0.0);
     let s = det.sqrt();
     let t = (m.x_axis.x + m.y_axis.y + 2.0 * s).max(0.0).sqrt();
-    if t == 0.0 { DMat2::ZERO } else { (m + DMat2::from_diagonal(DVec2::splat(s))) * (1.0 / t) }
+    if t == 0.0 {
+        DMat2::ZERO
+    } else {
+        (m + DMat2::from_diagonal(DVec2::splat(s))) * (1.0 / t)
+    }
 }
 
 impl SumOfSines {
@@ -124,8 +137,16 @@ impl SumOfSines {
     pub fn new(params: &NoiseParams, grad_cov: SlopeCov) -> Self {
         let n = params.components.clamp(1, NoiseParams::MAX_COMPONENTS) as usize;
         let octaves = params.octaves.clamp(1, 12) as usize;
-        let gain = if params.gain.is_finite() { params.gain.clamp(0.0, 4.0) } else { 0.5 };
-        let bw = if params.bandwidth.is_finite() { params.bandwidth.clamp(0.0, 1.5) } else { 0.0 };
+        let gain = if params.gain.is_finite() {
+            params.gain.clamp(0.0, 4.0)
+        } else {
+            0.5
+        };
+        let bw = if params.bandwidth.is_finite() {
+            params.bandwidth.clamp(0.0, 1.5)
+        } else {
+            0.0
+        };
         let mut state = params.seed ^ 0x5DEE_CE66_D1CE_4E5B;
         let mut waves = Vec::with_capacity(n);
         for i in 0..n {
@@ -134,7 +155,11 @@ impl SumOfSines {
             let angle = PI * (i as f64 + splitmix(&mut state)) / n as f64 * 7.0; // spread directions
             let amplitude = gain.powi(o as i32).max(1e-6);
             let phase = TAU * splitmix(&mut state);
-            waves.push(Wave { k: DVec2::from_angle(angle) * radius, amplitude, phase });
+            waves.push(Wave {
+                k: DVec2::from_angle(angle) * radius,
+                amplitude,
+                phase,
+            });
         }
         // Unit variance.
         let var: f64 = waves.iter().map(|w| w.amplitude * w.amplitude / 2.0).sum();
@@ -145,12 +170,19 @@ impl SumOfSines {
         let mut me = Self { waves };
         // Exact gradient covariance: k ↦ T^{1/2} G^{−1/2} k.
         let target = {
-            let t = DMat2::from_cols(DVec2::new(grad_cov.xx, grad_cov.xy), DVec2::new(grad_cov.xy, grad_cov.yy));
+            let t = DMat2::from_cols(
+                DVec2::new(grad_cov.xx, grad_cov.xy),
+                DVec2::new(grad_cov.xy, grad_cov.yy),
+            );
             let ok = t.x_axis.x.is_finite() && t.y_axis.y.is_finite() && t.x_axis.y.is_finite();
             if ok && t.x_axis.x + t.y_axis.y > 0.0 {
                 t
             } else {
-                let f = if params.frequency.is_finite() && params.frequency > 0.0 { params.frequency } else { 1.0 };
+                let f = if params.frequency.is_finite() && params.frequency > 0.0 {
+                    params.frequency
+                } else {
+                    1.0
+                };
                 // An isotropic ring at frequency f has per-axis gradient variance (2πf)²/2.
                 DMat2::from_diagonal(DVec2::splat((TAU * f).powi(2) / 2.0))
             }
@@ -169,7 +201,11 @@ impl SumOfSines {
         for w in &self.waves {
             let g = self.attenuation(w, fp);
             let s = w.amplitude * w.amplitude * TAU * TAU * (1.0 - g * g) / 2.0;
-            let s = if fp.cov == DMat2::ZERO { w.amplitude * w.amplitude * TAU * TAU / 2.0 } else { s };
+            let s = if fp.cov == DMat2::ZERO {
+                w.amplitude * w.amplitude * TAU * TAU / 2.0
+            } else {
+                s
+            };
             m += DMat2::from_cols(w.k * w.k.x, w.k * w.k.y) * s;
         }
         m
@@ -182,7 +218,10 @@ impl SumOfSines {
 
     /// f(x).
     pub fn value(&self, x: DVec2) -> f64 {
-        self.waves.iter().map(|w| w.amplitude * (TAU * w.k.dot(x) + w.phase).cos()).sum()
+        self.waves
+            .iter()
+            .map(|w| w.amplitude * (TAU * w.k.dot(x) + w.phase).cos())
+            .sum()
     }
 
     /// f(x) and ∇f(x).
@@ -216,7 +255,11 @@ impl SumOfSines {
             mean,
             std: var.max(0.0).sqrt(),
             mean_gradient: grad,
-            gradient_cov: SlopeCov { xx: cov.x_axis.x, yy: cov.y_axis.y, xy: cov.x_axis.y },
+            gradient_cov: SlopeCov {
+                xx: cov.x_axis.x,
+                yy: cov.y_axis.y,
+                xy: cov.x_axis.y,
+            },
         }
     }
 
@@ -227,13 +270,20 @@ impl SumOfSines {
 
     /// A Lipschitz constant of f along the horizontal unit direction `dir`: `Σ|a_i| 2π |k_i·dir|`.
     pub fn lipschitz_along(&self, dir: DVec2) -> f64 {
-        self.waves.iter().map(|w| w.amplitude.abs() * TAU * w.k.dot(dir).abs()).sum()
+        self.waves
+            .iter()
+            .map(|w| w.amplitude.abs() * TAU * w.k.dot(dir).abs())
+            .sum()
     }
 
     /// The gradient covariance of the unfiltered noise (equals the construction target).
     pub fn gradient_cov(&self) -> SlopeCov {
         let m = self.gradient_cov_matrix(Footprint::point());
-        SlopeCov { xx: m.x_axis.x, yy: m.y_axis.y, xy: m.x_axis.y }
+        SlopeCov {
+            xx: m.x_axis.x,
+            yy: m.y_axis.y,
+            xy: m.x_axis.y,
+        }
     }
 }
 
@@ -242,23 +292,42 @@ mod tests {
     use super::*;
 
     fn noise(target: SlopeCov) -> SumOfSines {
-        SumOfSines::new(&NoiseParams { components: 64, ..NoiseParams::default() }, target)
+        SumOfSines::new(
+            &NoiseParams {
+                components: 64,
+                ..NoiseParams::default()
+            },
+            target,
+        )
     }
 
     #[test]
     fn construction_meets_its_targets_exactly() {
-        let target = SlopeCov { xx: 2.0, yy: 0.5, xy: 0.3 };
+        let target = SlopeCov {
+            xx: 2.0,
+            yy: 0.5,
+            xy: 0.3,
+        };
         let n = noise(target);
-        let var: f64 = n.waves.iter().map(|w| w.amplitude * w.amplitude / 2.0).sum();
+        let var: f64 = n
+            .waves
+            .iter()
+            .map(|w| w.amplitude * w.amplitude / 2.0)
+            .sum();
         assert!((var - 1.0).abs() < 1e-12);
         let g = n.gradient_cov();
-        assert!((g.xx - 2.0).abs() < 1e-9 && (g.yy - 0.5).abs() < 1e-9 && (g.xy - 0.3).abs() < 1e-9, "{g:?}");
+        assert!(
+            (g.xx - 2.0).abs() < 1e-9 && (g.yy - 0.5).abs() < 1e-9 && (g.xy - 0.3).abs() < 1e-9,
+            "{g:?}"
+        );
     }
 
     /// Low-discrepancy sample positions over a square of side `extent` (R2 sequence).
     fn sample_points(count: usize, extent: f64) -> impl Iterator<Item = DVec2> {
         let (a1, a2) = (0.754_877_666_246_692_7, 0.569_840_290_998_053_3);
-        (0..count).map(move |i| DVec2::new((0.5 + a1 * i as f64).fract(), (0.5 + a2 * i as f64).fract()) * extent)
+        (0..count).map(move |i| {
+            DVec2::new((0.5 + a1 * i as f64).fract(), (0.5 + a2 * i as f64).fract()) * extent
+        })
     }
 
     #[test]
@@ -281,10 +350,24 @@ mod tests {
         let var = s2 / c - mean * mean;
         assert!(mean.abs() < 0.02, "mean {mean}");
         assert!((var - 1.0).abs() < 0.02, "variance {var}");
-        assert!((gxx / c / target.xx - 1.0).abs() < 0.02, "σ_nx² {} vs {}", gxx / c, target.xx);
-        assert!((gyy / c / target.yy - 1.0).abs() < 0.02, "σ_ny² {} vs {}", gyy / c, target.yy);
+        assert!(
+            (gxx / c / target.xx - 1.0).abs() < 0.02,
+            "σ_nx² {} vs {}",
+            gxx / c,
+            target.xx
+        );
+        assert!(
+            (gyy / c / target.yy - 1.0).abs() < 0.02,
+            "σ_ny² {} vs {}",
+            gyy / c,
+            target.yy
+        );
         // Close to Gaussian: kurtosis near 3.
-        assert!((s4 / c / (var * var) - 3.0).abs() < 0.15, "kurtosis {}", s4 / c / (var * var));
+        assert!(
+            (s4 / c / (var * var) - 3.0).abs() < 0.15,
+            "kurtosis {}",
+            s4 / c / (var * var)
+        );
     }
 
     #[test]
@@ -321,13 +404,21 @@ mod tests {
             let c = vars.len() as f64;
             let avg = vars.iter().sum::<f64>() / c;
             let se = (vars.iter().map(|v| (v - avg).powi(2)).sum::<f64>() / (c - 1.0) / c).sqrt();
-            assert!((avg - model).abs() < 3.0 * se + 0.01 * model, "r={r}: footprint variance {avg} ± {se} vs analytic {model}");
+            assert!(
+                (avg - model).abs() < 3.0 * se + 0.01 * model,
+                "r={r}: footprint variance {avg} ± {se} vs analytic {model}"
+            );
         }
     }
 
     #[test]
     fn degenerate_targets_are_finite() {
-        for t in [SlopeCov::default(), SlopeCov::from_std(1.0, 0.0), SlopeCov::isotropic(1e6), SlopeCov::isotropic(1e-9)] {
+        for t in [
+            SlopeCov::default(),
+            SlopeCov::from_std(1.0, 0.0),
+            SlopeCov::isotropic(1e6),
+            SlopeCov::isotropic(1e-9),
+        ] {
             let n = noise(t);
             let f = n.filtered(DVec2::new(0.3, 0.2), Footprint::isotropic(0.5));
             assert!(f.mean.is_finite() && f.std.is_finite() && f.mean_gradient.is_finite());

@@ -34,7 +34,11 @@ pub struct TableSpec {
 impl Default for TableSpec {
     /// 256×256 [HNPN14 Sec. 9], σ ∈ [0, 1]: the driver has unit variance, so no footprint of it is wider.
     fn default() -> Self {
-        Self { size_m: 256, size_sigma: 256, sigma_max: 1.0 }
+        Self {
+            size_m: 256,
+            size_sigma: 256,
+            sigma_max: 1.0,
+        }
     }
 }
 
@@ -47,7 +51,11 @@ impl TableSpec {
         Self {
             size_m: self.size_m.clamp(2, Self::MAX_SIZE),
             size_sigma: self.size_sigma.clamp(2, Self::MAX_SIZE),
-            sigma_max: if self.sigma_max.is_finite() && self.sigma_max > 0.0 { self.sigma_max } else { 1.0 },
+            sigma_max: if self.sigma_max.is_finite() && self.sigma_max > 0.0 {
+                self.sigma_max
+            } else {
+                1.0
+            },
         }
     }
 }
@@ -84,17 +92,25 @@ impl PreconvolvedTable {
             m_max = m_min + 1e-6;
         }
         let (nm, ns) = (spec.size_m, spec.size_sigma);
+        let degree = poly.degree();
         let mut texels = vec![[0.0f32; 4]; nm * ns];
         texels.par_chunks_mut(nm).enumerate().for_each(|(j, row)| {
             let sigma = spec.sigma_max * j as f64 / (ns - 1) as f64;
             let mut e = vec![0.0; poly.channels];
             for (i, texel) in row.iter_mut().enumerate() {
                 let m = m_min + (m_max - m_min) * i as f64 / (nm - 1) as f64;
-                poly.gaussian_expectation(m, sigma, &mut e);
+                poly.gaussian_expectation_fast(m, sigma, &mut e, degree);
                 *texel = map(&e);
             }
         });
-        Self { m_min, m_max, sigma_max: spec.sigma_max, size_m: nm, size_sigma: ns, texels }
+        Self {
+            m_min,
+            m_max,
+            sigma_max: spec.sigma_max,
+            size_m: nm,
+            size_sigma: ns,
+            texels,
+        }
     }
 
     /// Bilinear lookup at (m, σ) with clamp-to-edge, exactly as a linear GPU sampler does.
@@ -122,7 +138,11 @@ impl PreconvolvedTable {
 
 /// Split a continuous texel coordinate into the two neighbours and the blend weight, clamped.
 fn split(f: f64, n: usize) -> (usize, usize, f64) {
-    let f = if f.is_nan() { 0.0 } else { f.clamp(0.0, (n - 1) as f64) };
+    let f = if f.is_nan() {
+        0.0
+    } else {
+        f.clamp(0.0, (n - 1) as f64)
+    };
     let i0 = (f.floor() as usize).min(n - 2);
     (i0, i0 + 1, f - i0 as f64)
 }

@@ -69,7 +69,10 @@ pub fn integrate(f: impl Fn(f64) -> f64, a: f64, b: f64, panels: usize) -> f64 {
 /// obtained from the Golub–Welsch-free recurrence with Newton refinement. Exact for polynomials of
 /// degree 2n−1; weights sum to 1.
 pub fn gauss_hermite_normal(n: usize) -> (Vec<f64>, Vec<f64>) {
-    assert!((1..=64).contains(&n), "Gauss–Hermite supports 1..=64 points");
+    assert!(
+        (1..=64).contains(&n),
+        "Gauss–Hermite supports 1..=64 points"
+    );
     // Physicists' Hermite roots by Newton from the asymptotic guesses (Numerical Recipes' scheme),
     // then scaled: x_prob = √2 x_phys, w_prob = w_phys/√π.
     let mut nodes = vec![0.0; n];
@@ -124,8 +127,15 @@ mod tests {
             assert!((w.iter().sum::<f64>() - 2.0).abs() < 1e-13);
             for deg in 0..(2 * n) {
                 let got: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(deg as i32)).sum();
-                let want = if deg % 2 == 1 { 0.0 } else { 2.0 / (deg as f64 + 1.0) };
-                assert!((got - want).abs() < 1e-13, "n={n} deg={deg}: {got} vs {want}");
+                let want = if deg % 2 == 1 {
+                    0.0
+                } else {
+                    2.0 / (deg as f64 + 1.0)
+                };
+                assert!(
+                    (got - want).abs() < 1e-13,
+                    "n={n} deg={deg}: {got} vs {want}"
+                );
             }
         }
     }
@@ -147,8 +157,15 @@ mod tests {
                 if k > 0 {
                     dfact *= (2 * k - 1) as f64;
                 }
-                let got: f64 = x.iter().zip(&w).map(|(x, w)| w * x.powi(2 * k as i32)).sum();
-                assert!(((got - dfact) / dfact).abs() < 1e-10, "n={n} k={k}: {got} vs {dfact}");
+                let got: f64 = x
+                    .iter()
+                    .zip(&w)
+                    .map(|(x, w)| w * x.powi(2 * k as i32))
+                    .sum();
+                assert!(
+                    ((got - dfact) / dfact).abs() < 1e-10,
+                    "n={n} k={k}: {got} vs {dfact}"
+                );
             }
         }
     }

@@ -21,7 +21,11 @@ pub enum Correlation {
 /// Azimuthal correlation factor `λ(Δφ) = 4.41Δφ/(4.41Δφ + 1)` for Δφ ∈ [0, π] (numerics.md).
 /// 0 when view and light share an azimuth, → 0.93 when opposite.
 pub fn azimuth_factor(delta_phi: f64) -> f64 {
-    let d = if delta_phi.is_finite() { delta_phi.abs().min(std::f64::consts::PI) } else { 0.0 };
+    let d = if delta_phi.is_finite() {
+        delta_phi.abs().min(std::f64::consts::PI)
+    } else {
+        0.0
+    };
     4.41 * d / (4.41 * d + 1.0)
 }
 
@@ -63,12 +67,27 @@ impl MaskingShadowing {
                 if lo >= li { k * li } else { (li - lo) + k * lo }
             }
         };
-        Self { lambda_o: lo, lambda_i: li, excess, total: lo + excess }
+        Self {
+            lambda_o: lo,
+            lambda_i: li,
+            excess,
+            total: lo + excess,
+        }
     }
 
     /// From directions: ωo toward the eye, ωi toward the light, both in the tangent frame.
-    pub fn from_directions(wo: DVec3, wi: DVec3, slopes: &SlopeCov, correlation: Correlation) -> Self {
-        Self::new(lambda(wo, slopes), lambda(wi, slopes), azimuth_difference(wo, wi), correlation)
+    pub fn from_directions(
+        wo: DVec3,
+        wi: DVec3,
+        slopes: &SlopeCov,
+        correlation: Correlation,
+    ) -> Self {
+        Self::new(
+            lambda(wo, slopes),
+            lambda(wi, slopes),
+            azimuth_difference(wo, wi),
+            correlation,
+        )
     }
 
     /// Mean shadowing of the visible points `V̄ = (1 + Λo)/(1 + L)` [HNPN14 Eq. 12]
@@ -88,13 +107,25 @@ mod tests {
 
     /// ∫ Φ(t)^a φ(t) dt by quadrature (exactly 1/(a+1)).
     fn power_integral(a: f64) -> f64 {
-        integrate(|t| (a * log_norm_cdf(t)).exp() * norm_pdf(t), -12.0, 14.0, 2000)
+        integrate(
+            |t| (a * log_norm_cdf(t)).exp() * norm_pdf(t),
+            -12.0,
+            14.0,
+            2000,
+        )
     }
 
     #[test]
     fn mean_shadowing_matches_quadrature() {
         // [HNPN14 Eq. 12]: V̄ = ∫P^{Λo+Λi}p / ∫P^{Λo}p, checked by quadrature to 1e-9.
-        for &(lo, li) in &[(0.0, 0.0), (0.1, 0.3), (1.0, 0.2), (3.0, 7.0), (20.0, 0.5), (0.0, 5.0)] {
+        for &(lo, li) in &[
+            (0.0, 0.0),
+            (0.1, 0.3),
+            (1.0, 0.2),
+            (3.0, 7.0),
+            (20.0, 0.5),
+            (0.0, 5.0),
+        ] {
             let m = MaskingShadowing::new(lo, li, 1.0, Correlation::Uncorrelated);
             let want = power_integral(lo + li) / power_integral(lo);
             assert!((m.mean_shadowing() - want).abs() < 1e-9, "Λo={lo} Λi={li}");
@@ -107,11 +138,16 @@ mod tests {
         let w = direction(1.3, 0.2);
         let un = MaskingShadowing::from_directions(w, w, &s, Correlation::Uncorrelated);
         let co = MaskingShadowing::from_directions(w, w, &s, Correlation::HeightDirection);
-        assert_eq!(co.mean_shadowing(), 1.0, "light at the eye shadows nothing visible");
+        assert_eq!(
+            co.mean_shadowing(),
+            1.0,
+            "light at the eye shadows nothing visible"
+        );
         let l = un.lambda_o;
         assert!((un.mean_shadowing() - (1.0 + l) / (1.0 + 2.0 * l)).abs() < 1e-15);
         // Opposite azimuths approach the uncorrelated sum.
-        let opp = MaskingShadowing::new(2.0, 2.0, std::f64::consts::PI, Correlation::HeightDirection);
+        let opp =
+            MaskingShadowing::new(2.0, 2.0, std::f64::consts::PI, Correlation::HeightDirection);
         assert!((opp.total - (2.0 + 2.0 * azimuth_factor(std::f64::consts::PI))).abs() < 1e-15);
     }
 
@@ -122,7 +158,10 @@ mod tests {
                 for c in [Correlation::Uncorrelated, Correlation::HeightDirection] {
                     let m = MaskingShadowing::new(lo, li, 2.0, c);
                     let v = m.mean_shadowing();
-                    assert!((0.0..=1.0).contains(&v) && m.total.is_finite(), "{lo} {li} {c:?}");
+                    assert!(
+                        (0.0..=1.0).contains(&v) && m.total.is_finite(),
+                        "{lo} {li} {c:?}"
+                    );
                 }
             }
         }

@@ -27,28 +27,50 @@ impl SlopeCov {
     /// Axis-aligned anisotropic slopes with standard deviations σ_nx, σ_ny [HN12 Sec. 5.5].
     /// Negative or NaN inputs are treated as 0.
     pub fn from_std(sigma_x: f64, sigma_y: f64) -> Self {
-        let sx = if sigma_x.is_finite() { sigma_x.max(0.0) } else { 0.0 };
-        let sy = if sigma_y.is_finite() { sigma_y.max(0.0) } else { 0.0 };
-        Self { xx: sx * sx, yy: sy * sy, xy: 0.0 }
+        let sx = if sigma_x.is_finite() {
+            sigma_x.max(0.0)
+        } else {
+            0.0
+        };
+        let sy = if sigma_y.is_finite() {
+            sigma_y.max(0.0)
+        } else {
+            0.0
+        };
+        Self {
+            xx: sx * sx,
+            yy: sy * sy,
+            xy: 0.0,
+        }
     }
 
     /// Sum of two independent slope distributions: variances add [HN12 Sec. 5.5]
     /// (the "σ_n² + σ_n0²" convolution of the NDF with the base BRDF's).
     pub fn add(self, other: Self) -> Self {
-        Self { xx: self.xx + other.xx, yy: self.yy + other.yy, xy: self.xy + other.xy }
+        Self {
+            xx: self.xx + other.xx,
+            yy: self.yy + other.yy,
+            xy: self.xy + other.xy,
+        }
     }
 
     /// Scale slopes by `s` (heights scaled by s): the covariance scales by s².
     pub fn scaled(self, s: f64) -> Self {
         let s2 = s * s;
-        Self { xx: self.xx * s2, yy: self.yy * s2, xy: self.xy * s2 }
+        Self {
+            xx: self.xx * s2,
+            yy: self.yy * s2,
+            xy: self.xy * s2,
+        }
     }
 
     /// Standard deviation of the slope projected on the horizontal unit direction (cos φ, sin φ):
     /// `σ(φ)² = cos²φ σ_x² + 2 cos φ sin φ c_xy + sin²φ σ_y²` (design.md, "Masking–shadowing").
     /// Never negative (rounding is clamped at 0).
     pub fn projected_std(&self, cos_phi: f64, sin_phi: f64) -> f64 {
-        let v = cos_phi * cos_phi * self.xx + 2.0 * cos_phi * sin_phi * self.xy + sin_phi * sin_phi * self.yy;
+        let v = cos_phi * cos_phi * self.xx
+            + 2.0 * cos_phi * sin_phi * self.xy
+            + sin_phi * sin_phi * self.yy;
         v.max(0.0).sqrt()
     }
 
@@ -64,7 +86,11 @@ mod tests {
 
     #[test]
     fn projection_matches_rotated_variance() {
-        let c = SlopeCov { xx: 0.09, yy: 0.01, xy: 0.02 };
+        let c = SlopeCov {
+            xx: 0.09,
+            yy: 0.01,
+            xy: 0.02,
+        };
         for i in 0..16 {
             let phi = f64::from(i) * 0.4;
             let (s, co) = phi.sin_cos();

@@ -124,7 +124,13 @@ mod tests {
             }
         }
         // Below the horizon nothing is visible; at the normal everything is.
-        assert_eq!(visibility_dir(DVec3::new(1.0, 0.0, -0.1), 5.0, &SlopeCov::isotropic(0.3)), 0.0);
-        assert_eq!(visibility_dir(DVec3::Z, -5.0, &SlopeCov::isotropic(0.3)), 1.0);
+        assert_eq!(
+            visibility_dir(DVec3::new(1.0, 0.0, -0.1), 5.0, &SlopeCov::isotropic(0.3)),
+            0.0
+        );
+        assert_eq!(
+            visibility_dir(DVec3::Z, -5.0, &SlopeCov::isotropic(0.3)),
+            1.0
+        );
     }
 }

@@ -301,14 +301,20 @@ pub(crate) mod tests {
             }
             if want.abs() < 1e-300 {
                 // Subnormal results: only absolute agreement is meaningful.
-                assert!((got - want).abs() < 1e-310, "{name}({x}) = {got}, want {want}");
+                assert!(
+                    (got - want).abs() < 1e-310,
+                    "{name}({x}) = {got}, want {want}"
+                );
                 continue;
             }
             let rel = ((got - want) / want).abs();
             if rel > worst.0 {
                 worst = (rel, format!("{name}({x}) = {got:e}, want {want:e}"));
             }
-            assert!(rel <= 1e-12, "{name}({x}) = {got:e}, want {want:e}, rel {rel:e}");
+            assert!(
+                rel <= 1e-12,
+                "{name}({x}) = {got:e}, want {want:e}, rel {rel:e}"
+            );
         }
         eprintln!("worst relative error: {:e} at {}", worst.0, worst.1);
     }
@@ -317,22 +323,48 @@ pub(crate) mod tests {
     fn exact_identities() {
         for i in -400..=400 {
             let x = f64::from(i) * 0.0173;
-            assert!((erf(x) + erfc(x) - 1.0).abs() < 2e-16 * 4.0, "erf+erfc at {x}");
+            assert!(
+                (erf(x) + erfc(x) - 1.0).abs() < 2e-16 * 4.0,
+                "erf+erfc at {x}"
+            );
             assert!((erf(-x) + erf(x)).abs() == 0.0, "erf odd at {x}");
-            assert!((erfc(-x) + erfc(x) - 2.0).abs() < 1e-15, "erfc reflection at {x}");
+            assert!(
+                (erfc(-x) + erfc(x) - 2.0).abs() < 1e-15,
+                "erfc reflection at {x}"
+            );
             let p = norm_cdf(x);
             // Round trip only where Φ⁻¹ is well conditioned in f64 (p not rounded next to 1).
             if p > 1e-300 && x <= 0.5 {
                 let back = norm_quantile(p);
-                assert!((back - x).abs() < 1e-12 * x.abs().max(1.0), "quantile(cdf({x})) = {back}");
+                assert!(
+                    (back - x).abs() < 1e-12 * x.abs().max(1.0),
+                    "quantile(cdf({x})) = {back}"
+                );
             }
         }
     }
 
     #[test]
     fn edge_cases_are_finite() {
-        for &x in &[0.0, -0.0, 1e-320, f64::MIN_POSITIVE, 1e-300, 1e300, -1e300, f64::MAX, f64::MIN] {
-            for v in [erf(x), erfc(x), erfcx(x), norm_pdf(x), norm_cdf(x), smith_lambda(x)] {
+        for &x in &[
+            0.0,
+            -0.0,
+            1e-320,
+            f64::MIN_POSITIVE,
+            1e-300,
+            1e300,
+            -1e300,
+            f64::MAX,
+            f64::MIN,
+        ] {
+            for v in [
+                erf(x),
+                erfc(x),
+                erfcx(x),
+                norm_pdf(x),
+                norm_cdf(x),
+                smith_lambda(x),
+            ] {
                 assert!(v.is_finite(), "non-finite at {x}");
             }
             assert!(log_norm_cdf(x).is_finite(), "log cdf at {x}");

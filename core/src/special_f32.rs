@@ -165,7 +165,10 @@ mod tests {
             }
             let rel = ((got - want) / want).abs();
             worst = worst.max(rel);
-            assert!(rel <= 1e-5, "{name}({x}): f32 {got:e}, want {want:e}, rel {rel:e}");
+            assert!(
+                rel <= 1e-5,
+                "{name}({x}): f32 {got:e}, want {want:e}, rel {rel:e}"
+            );
             checked += 1;
         }
         assert!(checked > 200, "only {checked} f32 cases checked");
@@ -190,7 +193,10 @@ mod tests {
                     continue;
                 }
                 let rel = ((a - b) / b).abs();
-                assert!(rel < 1e-5 || (a - b).abs() < 1e-7 && k == 0, "fn {k} at {x}: {a} vs {b}");
+                assert!(
+                    rel < 1e-5 || (a - b).abs() < 1e-7 && k == 0,
+                    "fn {k} at {x}: {a} vs {b}"
+                );
             }
             if x > 0.0 {
                 let a = f64::from(smith_lambda(xf));

@@ -54,7 +54,14 @@ impl Surface {
         };
         let k_max = noise.waves.iter().map(|w| w.k.length()).fold(0.0, f64::max);
         let min_step = if k_max > 0.0 { 1e-4 / k_max } else { 1e-6 };
-        Some(Self { g_lip: transfer.max_derivative(), noise, sigma_h, transfer, h_max: sigma_h * g_abs_max, min_step })
+        Some(Self {
+            g_lip: transfer.max_derivative(),
+            noise,
+            sigma_h,
+            transfer,
+            h_max: sigma_h * g_abs_max,
+            min_step,
+        })
     }
 
     /// h(x).
@@ -82,7 +89,11 @@ impl Surface {
     pub fn march(&self, o: DVec3, d: DVec3) -> Trace {
         let dxy = DVec2::new(d.x, d.y);
         let r = dxy.length();
-        let k = if r > 0.0 { self.lipschitz_along(dxy / r) } else { 0.0 };
+        let k = if r > 0.0 {
+            self.lipschitz_along(dxy / r)
+        } else {
+            0.0
+        };
         let rate = d.z.abs() + k * r;
         if rate <= 0.0 {
             return Trace::Escape;
@@ -142,8 +153,14 @@ mod tests {
 
     fn surface() -> Surface {
         let m = Material {
-            heights: Heights { sigma_h: 0.1, transfer: TransferFunction::Identity },
-            slopes: Slopes { sigma_nx: 0.5, sigma_ny: 0.5 },
+            heights: Heights {
+                sigma_h: 0.1,
+                transfer: TransferFunction::Identity,
+            },
+            slopes: Slopes {
+                sigma_nx: 0.5,
+                sigma_ny: 0.5,
+            },
             ..Material::default()
         };
         Surface::new(&m).unwrap()
@@ -156,7 +173,9 @@ mod tests {
         for i in 0..200 {
             let y = DVec2::new(0.37 * i as f64, 0.11 * i as f64);
             let o = DVec3::new(y.x, y.y, 0.0) - d * ((s.h_max + 0.01) / -d.z);
-            let Trace::Hit(t) = s.march(o, d) else { panic!("a downward ray must hit") };
+            let Trace::Hit(t) = s.march(o, d) else {
+                panic!("a downward ray must hit")
+            };
             let p = o + d * t;
             let gap = p.z - s.height(DVec2::new(p.x, p.y));
             assert!(gap.abs() < 1e-9, "hit point off the surface by {gap}");
@@ -164,7 +183,10 @@ mod tests {
             let n = 20_000;
             for j in 0..n {
                 let q = o + d * (t * j as f64 / n as f64);
-                assert!(q.z - s.height(DVec2::new(q.x, q.y)) > -1e-9, "missed an earlier crossing");
+                assert!(
+                    q.z - s.height(DVec2::new(q.x, q.y)) > -1e-9,
+                    "missed an earlier crossing"
+                );
             }
         }
     }
@@ -188,9 +210,15 @@ mod tests {
         }
         let up = DVec3::new(0.0, 0.0, 1.0);
         assert!(s.sees(DVec3::new(hi.1.x, hi.1.y, hi.0), up));
-        assert!(s.sees(DVec3::new(lo.1.x, lo.1.y, lo.0), up), "a heightfield never shadows straight up");
+        assert!(
+            s.sees(DVec3::new(lo.1.x, lo.1.y, lo.0), up),
+            "a heightfield never shadows straight up"
+        );
         let grazing = DVec3::new(1.0, 0.0, 0.02).normalize();
-        assert!(!s.sees(DVec3::new(lo.1.x, lo.1.y, lo.0), grazing), "the lowest pit cannot see the horizon");
+        assert!(
+            !s.sees(DVec3::new(lo.1.x, lo.1.y, lo.0), grazing),
+            "the lowest pit cannot see the horizon"
+        );
         assert!(!s.sees(DVec3::new(lo.1.x, lo.1.y, lo.0), DVec3::new(1.0, 0.0, -0.1)));
     }
 }

@@ -88,7 +88,14 @@ impl Curve {
     /// spirit of [HNPN14 Fig. 11] (the figure is not in our copy). Normalised.
     pub fn moss() -> Self {
         Self {
-            points: vec![[-3.0, 0.0], [-0.3, 0.02], [0.3, 0.35], [0.9, 0.85], [1.6, 1.0], [3.0, 1.05]],
+            points: vec![
+                [-3.0, 0.0],
+                [-0.3, 0.02],
+                [0.3, 0.35],
+                [0.9, 0.85],
+                [1.6, 1.0],
+                [3.0, 1.05],
+            ],
             interpolation: CurveInterpolation::MonotoneCubic,
         }
         .normalized()
@@ -98,7 +105,14 @@ impl Curve {
     /// [HNPN14 Fig. 11]. Normalised.
     pub fn sponge() -> Self {
         Self {
-            points: vec![[-3.0, -1.1], [-1.2, -1.0], [-0.6, -0.55], [-0.2, -0.05], [0.3, 0.0], [3.0, 0.02]],
+            points: vec![
+                [-3.0, -1.1],
+                [-1.2, -1.0],
+                [-0.6, -0.55],
+                [-0.2, -0.05],
+                [0.3, 0.0],
+                [3.0, 0.02],
+            ],
             interpolation: CurveInterpolation::MonotoneCubic,
         }
         .normalized()
@@ -114,7 +128,11 @@ impl Curve {
             points.push([x0 + 0.15 * w, s as f64]);
             points.push([x0 + 0.85 * w, s as f64 + 0.08]);
         }
-        Self { points, interpolation: CurveInterpolation::MonotoneCubic }.normalized()
+        Self {
+            points,
+            interpolation: CurveInterpolation::MonotoneCubic,
+        }
+        .normalized()
     }
 
     /// Per-segment cubic coefficients in the local variable t (zero-width segments get zeros).
@@ -125,8 +143,11 @@ impl Curve {
             return vec![];
         }
         let h: Vec<f64> = p.windows(2).map(|w| w[1][0] - w[0][0]).collect();
-        let delta: Vec<Option<f64>> =
-            p.windows(2).zip(&h).map(|(w, h)| (*h > 0.0).then(|| (w[1][1] - w[0][1]) / h)).collect();
+        let delta: Vec<Option<f64>> = p
+            .windows(2)
+            .zip(&h)
+            .map(|(w, h)| (*h > 0.0).then(|| (w[1][1] - w[0][1]) / h))
+            .collect();
         // Tangents (Fritsch–Carlson), treating vertical segments as breaks.
         let mut m = vec![0.0; n];
         if self.interpolation == CurveInterpolation::MonotoneCubic {
@@ -166,7 +187,12 @@ impl Curve {
                     CurveInterpolation::Linear => [y0, y1 - y0, 0.0, 0.0],
                     CurveInterpolation::MonotoneCubic => {
                         let (m0, m1) = (hk * m[k], hk * m[k + 1]);
-                        [y0, m0, 3.0 * (y1 - y0) - 2.0 * m0 - m1, 2.0 * (y0 - y1) + m0 + m1]
+                        [
+                            y0,
+                            m0,
+                            3.0 * (y1 - y0) - 2.0 * m0 - m1,
+                            2.0 * (y0 - y1) + m0 + m1,
+                        ]
                     }
                 }
             })
@@ -206,7 +232,10 @@ impl Curve {
     /// Record every problem: fewer than two points, non-finite values, unsorted f.
     pub fn validate(&self, field: &str, problems: &mut Problems) {
         if self.points.len() < 2 {
-            problems.push(format!("{field}.points"), "a transfer curve needs at least two points");
+            problems.push(
+                format!("{field}.points"),
+                "a transfer curve needs at least two points",
+            );
         }
         for (i, p) in self.points.iter().enumerate() {
             problems.finite(&format!("{field}.points[{i}][0]"), p[0]);
@@ -216,7 +245,10 @@ impl Curve {
             if w[1][0] < w[0][0] {
                 problems.push(
                     format!("{field}.points[{}][0]", i + 1),
-                    format!("points must be sorted by f: {} comes after {}", w[1][0], w[0][0]),
+                    format!(
+                        "points must be sorted by f: {} comes after {}",
+                        w[1][0], w[0][0]
+                    ),
                 );
             }
         }
@@ -284,7 +316,12 @@ impl TransferFunction {
     /// Exact moments of g and g′ under `N(m, σ²)` [HNPN14 Eqs. 21, 22, 27, 28].
     pub fn moments(&self, m: f64, sigma: f64) -> TransferMoments {
         match self {
-            Self::Identity => TransferMoments { mean: m, std: sigma.max(0.0), mean_deriv: 1.0, std_deriv: 0.0 },
+            Self::Identity => TransferMoments {
+                mean: m,
+                std: sigma.max(0.0),
+                mean_deriv: 1.0,
+                std_deriv: 0.0,
+            },
             Self::Curve(c) => {
                 let mut e = [0.0; 4];
                 c.moment_poly().gaussian_expectation(m, sigma, &mut e);
@@ -297,10 +334,18 @@ impl TransferFunction {
     pub fn preconvolve(&self, spec: TableSpec) -> Option<PreconvolvedTable> {
         let Self::Curve(c) = self else { return None };
         let spec = spec.sanitized();
-        let (lo, hi) = (c.points.first().map_or(0.0, |p| p[0]), c.points.last().map_or(0.0, |p| p[0]));
+        let (lo, hi) = (
+            c.points.first().map_or(0.0, |p| p[0]),
+            c.points.last().map_or(0.0, |p| p[0]),
+        );
         let margin = MARGIN_SIGMAS * spec.sigma_max;
         let m = central_f32;
-        Some(PreconvolvedTable::build(&c.moment_poly(), spec, (lo - margin, hi + margin), m))
+        Some(PreconvolvedTable::build(
+            &c.moment_poly(),
+            spec,
+            (lo - margin, hi + margin),
+            m,
+        ))
     }
 }
 
@@ -315,7 +360,12 @@ fn central(e: &[f64]) -> TransferMoments {
 
 fn central_f32(e: &[f64]) -> [f32; 4] {
     let c = central(e);
-    [c.mean as f32, c.std as f32, c.mean_deriv as f32, c.std_deriv as f32]
+    [
+        c.mean as f32,
+        c.std as f32,
+        c.mean_deriv as f32,
+        c.std_deriv as f32,
+    ]
 }
 
 /// The transformed surface's Gaussian statistics [HNPN14 Eqs. 19–26] for `h = σ_h·g(f)`.
@@ -325,7 +375,12 @@ fn central_f32(e: &[f64]) -> [f32; 4] {
 /// value and gradient are uncorrelated at a point [HNPN14 Sec. 7]). Then
 /// `E[∂h] = σ_h ḡ′ E[∂f]` [Eq. 24] and
 /// `Cov(∂h) = σ_h² (Var g′ · E[∂f ∂fᵀ] + ḡ′² Cov ∂f)` [Eqs. 25–26, rearranged without cancellation].
-pub fn transformed_statistics(moments: TransferMoments, sigma_h: f64, grad_mean: DVec2, grad_cov: SlopeCov) -> SurfaceStats {
+pub fn transformed_statistics(
+    moments: TransferMoments,
+    sigma_h: f64,
+    grad_mean: DVec2,
+    grad_cov: SlopeCov,
+) -> SurfaceStats {
     let var_d = moments.std_deriv * moments.std_deriv;
     let md2 = moments.mean_deriv * moments.mean_deriv;
     let second = SlopeCov {
@@ -357,7 +412,10 @@ mod tests {
         for c in [Curve::moss(), Curve::sponge(), Curve::terraces(4)] {
             let t = TransferFunction::Curve(c.clone());
             for p in &c.points {
-                assert!((t.eval(p[0]) - p[1]).abs() < 1e-12, "passes through its points");
+                assert!(
+                    (t.eval(p[0]) - p[1]).abs() < 1e-12,
+                    "passes through its points"
+                );
             }
             let mut prev = f64::NEG_INFINITY;
             for i in 0..=2000 {
@@ -369,7 +427,10 @@ mod tests {
                 let fd = (t.eval(f + 1e-6) - t.eval(f - 1e-6)) / 2e-6;
                 let knot_near = c.points.iter().any(|p| (p[0] - f).abs() < 2e-6);
                 if !knot_near {
-                    assert!((fd - t.derivative(f)).abs() < 1e-5 * (1.0 + fd.abs()), "g′ at {f}");
+                    assert!(
+                        (fd - t.derivative(f)).abs() < 1e-5 * (1.0 + fd.abs()),
+                        "g′ at {f}"
+                    );
                 }
             }
         }
@@ -386,7 +447,9 @@ mod tests {
     #[test]
     fn moments_match_monte_carlo_and_tables() {
         let t = TransferFunction::Curve(Curve::moss());
-        let table = t.preconvolve(TableSpec::default()).expect("curve has a table");
+        let table = t
+            .preconvolve(TableSpec::default())
+            .expect("curve has a table");
         let mut rng = Rng(3);
         for &(m, s) in &[(0.0, 1.0), (0.5, 0.3), (-1.0, 0.6)] {
             let n = 400_000;
@@ -406,8 +469,18 @@ mod tests {
             let got = [exact.mean, exact.std, exact.mean_deriv, exact.std_deriv];
             let tab = table.sample(m, s);
             for k in 0..4 {
-                assert!((got[k] - want[k]).abs() < 6e-3, "m={m} σ={s} moment {k}: {} vs MC {}", got[k], want[k]);
-                assert!((tab[k] - got[k]).abs() < 3e-3, "table vs exact, moment {k}: {} vs {}", tab[k], got[k]);
+                assert!(
+                    (got[k] - want[k]).abs() < 6e-3,
+                    "m={m} σ={s} moment {k}: {} vs MC {}",
+                    got[k],
+                    want[k]
+                );
+                assert!(
+                    (tab[k] - got[k]).abs() < 3e-3,
+                    "table vs exact, moment {k}: {} vs {}",
+                    tab[k],
+                    got[k]
+                );
             }
         }
     }
@@ -418,7 +491,11 @@ mod tests {
             TransferFunction::Identity.moments(0.2, 0.7),
             2.0,
             DVec2::new(0.1, -0.3),
-            SlopeCov { xx: 0.04, yy: 0.09, xy: 0.01 },
+            SlopeCov {
+                xx: 0.04,
+                yy: 0.09,
+                xy: 0.01,
+            },
         );
         assert!((st.height_mean - 0.4).abs() < 1e-15 && (st.height_std - 1.4).abs() < 1e-15);
         assert!((st.slope_mean - DVec2::new(0.2, -0.6)).length() < 1e-15);
@@ -427,14 +504,21 @@ mod tests {
 
     #[test]
     fn vertical_segments_and_validation() {
-        let c = Curve { points: vec![[-1.0, 0.0], [0.0, 0.0], [0.0, 1.0], [1.0, 1.0]], interpolation: CurveInterpolation::Linear };
+        let c = Curve {
+            points: vec![[-1.0, 0.0], [0.0, 0.0], [0.0, 1.0], [1.0, 1.0]],
+            interpolation: CurveInterpolation::Linear,
+        };
         let t = TransferFunction::Curve(c.clone());
         assert_eq!(t.eval(-0.5), 0.0);
         assert_eq!(t.eval(0.5), 1.0);
         let m = t.moments(0.0, 0.5);
         assert!((m.mean - 0.5).abs() < 1e-12 && m.mean_deriv == 0.0);
         let mut p = Problems::default();
-        Curve { points: vec![[1.0, f64::NAN], [0.0, 0.0]], interpolation: CurveInterpolation::Linear }.validate("t", &mut p);
+        Curve {
+            points: vec![[1.0, f64::NAN], [0.0, 0.0]],
+            interpolation: CurveInterpolation::Linear,
+        }
+        .validate("t", &mut p);
         assert_eq!(p.0.len(), 2);
     }
 }

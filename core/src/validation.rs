@@ -25,7 +25,10 @@ pub struct Problems(pub Vec<Problem>);
 impl Problems {
     /// Record a problem.
     pub fn push(&mut self, field: impl Into<String>, message: impl Into<String>) {
-        self.0.push(Problem { field: field.into(), message: message.into() });
+        self.0.push(Problem {
+            field: field.into(),
+            message: message.into(),
+        });
     }
 
     /// `value` must be finite.
