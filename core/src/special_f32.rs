@@ -46,6 +46,19 @@ pub fn cf_tail(x: f32) -> f32 {
     t
 }
 
+/// `erfc(x)` for x ≥ 1 by the continued fraction; 0 past 10.5 (f32 underflow).
+pub fn erfc_upper(x: f32) -> f32 {
+    if x > 10.5 {
+        return 0.0;
+    }
+    (-x * x).exp() / (SQRT_PI * (x + 0.5 / cf_tail(x)))
+}
+
+/// `erf(x)` for |x| < 1 by the series.
+pub fn erf_small(x: f32) -> f32 {
+    FRAC_2_SQRT_PI * (-x * x).exp() * erf_series_sum(x)
+}
+
 /// `erfcx(x) = e^{x²} erfc(x)`; saturates to `f32::MAX` for x < −9.3 where it overflows.
 pub fn erfcx(x: f32) -> f32 {
     if x >= CF_THRESHOLD {
@@ -56,7 +69,8 @@ pub fn erfcx(x: f32) -> f32 {
     } else if x > -CF_THRESHOLD {
         (x * x).exp() - FRAC_2_SQRT_PI * erf_series_sum(x)
     } else {
-        let v = 2.0 * (x * x).exp() - erfcx(-x);
+        let y = -x;
+        let v = 2.0 * (x * x).exp() - 1.0 / (SQRT_PI * (y + 0.5 / cf_tail(y)));
         if v.is_finite() { v } else { f32::MAX }
     }
 }
@@ -65,24 +79,21 @@ pub fn erfcx(x: f32) -> f32 {
 pub fn erf(x: f32) -> f32 {
     let a = x.abs();
     let v = if a < CF_THRESHOLD {
-        FRAC_2_SQRT_PI * (-a * a).exp() * erf_series_sum(a)
+        erf_small(a)
     } else {
-        1.0 - erfc(a)
+        1.0 - erfc_upper(a)
     };
-    v.copysign(x)
+    if x < 0.0 { -v } else { v }
 }
 
-/// `erfc(x)` with relative accuracy in the upper tail; 0 past x ≈ 9.2.
+/// `erfc(x)` with relative accuracy in the upper tail; 0 past x ≈ 10.5.
 pub fn erfc(x: f32) -> f32 {
     if x >= CF_THRESHOLD {
-        if x > 10.5 {
-            return 0.0;
-        }
-        (-x * x).exp() / (SQRT_PI * (x + 0.5 / cf_tail(x)))
+        erfc_upper(x)
     } else if x > -CF_THRESHOLD {
-        1.0 - erf(x)
+        1.0 - erf_small(x)
     } else {
-        2.0 - erfc(-x)
+        2.0 - erfc_upper(-x)
     }
 }
 
@@ -96,7 +107,7 @@ pub fn norm_cdf(z: f32) -> f32 {
     0.5 * erfc(-z * std::f32::consts::FRAC_1_SQRT_2)
 }
 
-/// ln Φ(z); finite for every finite z (uses erfcx below z = −3).
+/// ln Φ(z); finite for every finite z (uses erfcx below z = −3; `ln(1 − Q)` by its series for small Q).
 pub fn log_norm_cdf(z: f32) -> f32 {
     if z < -3.0 {
         let x = -z * std::f32::consts::FRAC_1_SQRT_2;
@@ -105,13 +116,19 @@ pub fn log_norm_cdf(z: f32) -> f32 {
     } else if z < 0.0 {
         norm_cdf(z).ln()
     } else {
-        (-0.5 * erfc(z * std::f32::consts::FRAC_1_SQRT_2)).ln_1p()
+        let q = 0.5 * erfc(z * std::f32::consts::FRAC_1_SQRT_2);
+        // ln(1 − q) = −q(1 + q/2 + q²/3 + q³/4 + q⁴/5 + …): truncation ≤ q⁵/6 < 6e-8 relative.
+        if q < 0.05 {
+            -q * (1.0 + q * (0.5 + q * (1.0 / 3.0 + q * (0.25 + q * 0.2))))
+        } else {
+            (1.0 - q).ln()
+        }
     }
 }
 
 /// Smith's Λ(ν) [HN12 Eq. 6], cancellation-free above ν = 1 (see [`crate::special::smith_lambda`]).
 pub fn smith_lambda(nu: f32) -> f32 {
-    let nu = nu.max(NU_MIN);
+    let nu = if nu.is_nan() { nu } else { nu.max(NU_MIN) };
     if nu >= CF_THRESHOLD {
         if nu > 10.5 {
             return 0.0;

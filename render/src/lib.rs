@@ -1,1 +1,11 @@
-//! placeholder
+//! # lodestone-render
+//!
+//! Lodestone's renderer on wgpu, with no UI. It grows into one render target per view (naive MIP,
+//! ground truth, filtered) with offscreen readback; today it holds device setup, the WGSL mirrors of
+//! `lodestone-core`'s f32 functions and the harness that checks them on the adapter.
+
+pub mod compute;
+pub mod gpu;
+pub mod shaders;
+
+pub use gpu::{GpuContext, GpuError};

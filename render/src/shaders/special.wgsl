@@ -1,0 +1,115 @@
+// Special functions in f32: the WGSL mirror of lodestone-core's `special_f32` module, function for
+// function and under the same names. See that module for the algorithms and their accuracy:
+// series below 1, Laplace's continued fraction (depth 48) at and above 1 [A&S 7.1.6, 7.1.14],
+// Smith's Λ cancellation-free [HN12 Eq. 6].
+
+const SQRT_PI: f32 = 1.7724539;
+const FRAC_1_SQRT_2PI: f32 = 0.3989423;
+const FRAC_2_SQRT_PI: f32 = 1.1283792;
+const FRAC_1_SQRT_2: f32 = 0.70710677;
+const NU_MIN: f32 = 1e-30;
+const F32_MAX: f32 = 3.4028235e38;
+const CF_THRESHOLD: f32 = 1.0;
+const CF_DEPTH: u32 = 48u;
+const SERIES_TERMS: u32 = 24u;
+
+fn erf_series_sum(x: f32) -> f32 {
+    let x2 = x * x;
+    var term = x;
+    var sum = x;
+    for (var n = 1u; n <= SERIES_TERMS; n = n + 1u) {
+        term = term * (2.0 * x2 / (2.0 * f32(n) + 1.0));
+        sum = sum + term;
+    }
+    return sum;
+}
+
+fn cf_tail(x: f32) -> f32 {
+    var t = x;
+    for (var n = CF_DEPTH; n >= 1u; n = n - 1u) {
+        t = x + (f32(n) + 1.0) * 0.5 / t;
+    }
+    return t;
+}
+
+fn erfc_upper(x: f32) -> f32 {
+    if (x > 10.5) {
+        return 0.0;
+    }
+    return exp(-x * x) / (SQRT_PI * (x + 0.5 / cf_tail(x)));
+}
+
+fn erf_small(x: f32) -> f32 {
+    return FRAC_2_SQRT_PI * exp(-x * x) * erf_series_sum(x);
+}
+
+fn erfcx(x: f32) -> f32 {
+    if (x >= CF_THRESHOLD) {
+        if (x > 1e18) {
+            return 1.0 / (SQRT_PI * x);
+        }
+        return 1.0 / (SQRT_PI * (x + 0.5 / cf_tail(x)));
+    } else if (x > -CF_THRESHOLD) {
+        return exp(x * x) - FRAC_2_SQRT_PI * erf_series_sum(x);
+    }
+    let y = -x;
+    if (x * x > 88.7) {
+        return F32_MAX;
+    }
+    return 2.0 * exp(x * x) - 1.0 / (SQRT_PI * (y + 0.5 / cf_tail(y)));
+}
+
+fn erf(x: f32) -> f32 {
+    let a = abs(x);
+    var v: f32;
+    if (a < CF_THRESHOLD) {
+        v = erf_small(a);
+    } else {
+        v = 1.0 - erfc_upper(a);
+    }
+    return select(v, -v, x < 0.0);
+}
+
+fn erfc(x: f32) -> f32 {
+    if (x >= CF_THRESHOLD) {
+        return erfc_upper(x);
+    } else if (x > -CF_THRESHOLD) {
+        return 1.0 - erf_small(x);
+    }
+    return 2.0 - erfc_upper(-x);
+}
+
+fn norm_pdf(z: f32) -> f32 {
+    return FRAC_1_SQRT_2PI * exp(-0.5 * z * z);
+}
+
+fn norm_cdf(z: f32) -> f32 {
+    return 0.5 * erfc(-z * FRAC_1_SQRT_2);
+}
+
+fn log_norm_cdf(z: f32) -> f32 {
+    if (z < -3.0) {
+        let x = -z * FRAC_1_SQRT_2;
+        return log(0.5 * erfcx(x)) - x * x;
+    } else if (z < 0.0) {
+        return log(norm_cdf(z));
+    }
+    let q = 0.5 * erfc(z * FRAC_1_SQRT_2);
+    if (q < 0.05) {
+        return -q * (1.0 + q * (0.5 + q * (1.0 / 3.0 + q * (0.25 + q * 0.2))));
+    }
+    return log(1.0 - q);
+}
+
+fn smith_lambda(nu_in: f32) -> f32 {
+    let nu = max(nu_in, NU_MIN);
+    if (nu >= CF_THRESHOLD) {
+        if (nu > 10.5) {
+            return 0.0;
+        }
+        let tail = 0.5 / cf_tail(nu);
+        let k = nu + tail;
+        return exp(-nu * nu) / (2.0 * SQRT_PI) * tail / (nu * k);
+    }
+    return 0.5 * (exp(-nu * nu) / (nu * SQRT_PI) - erfc(nu));
+}
