@@ -80,7 +80,7 @@ impl BaseBrdf {
             return 0.0;
         }
         let s0 = self.roughness.max(0.0);
-        let cov = extra.add(SlopeCov::isotropic(s0));
+        let cov = extra + SlopeCov::isotropic(s0);
         let d = gaussian2(slope_of(h) - slope_of(n), cov);
         self.specular * d / (4.0 * h.z.powi(4) * wo.z)
     }
@@ -136,7 +136,7 @@ mod tests {
             }
         }
         let h = (wo + wi).normalize();
-        let want = gaussian2(slope_of(h), sigma.add(SlopeCov::isotropic(0.15)));
+        let want = gaussian2(slope_of(h), sigma + SlopeCov::isotropic(0.15));
         assert!((avg - want).abs() < 1e-9 * want, "{avg} vs {want}");
         let macro_lobe = b.specular_with(DVec3::Z, wo, wi, sigma);
         assert!((macro_lobe - want / (4.0 * h.z.powi(4) * wo.z)).abs() < 1e-12);

@@ -358,6 +358,31 @@ impl Prepared {
     }
 }
 
+impl Config {
+    /// A far, fully filtered footprint for `prepared`: isotropic with a standard deviation of 20 times
+    /// the longest wavelength of the driver, centred away from the origin.
+    pub fn far(prepared: &Prepared, wo: DVec3, wi: DVec3) -> Self {
+        let k_min = prepared
+            .surface
+            .noise
+            .waves
+            .iter()
+            .map(|w| w.k.length())
+            .fold(f64::INFINITY, f64::min);
+        let r = if k_min.is_finite() && k_min > 0.0 {
+            20.0 / k_min
+        } else {
+            1.0
+        };
+        Self {
+            wo,
+            wi,
+            x0: DVec2::new(3.0, -7.0),
+            footprint: Footprint::isotropic(r),
+        }
+    }
+}
+
 /// 1 when the light is above the horizon of both the macro surface and the facet n, else 0.
 fn lit(cfg: &Config, n: DVec3) -> f64 {
     if cfg.wi.z > 0.0 && n.dot(cfg.wi) > 0.0 {
@@ -417,7 +442,7 @@ pub fn filtered_specular(f0: f64, roughness: f64, sigma: &SlopeCov, wo: DVec3, w
     } else {
         wo.z
     };
-    let d = gaussian2(sh, sigma.add(SlopeCov::isotropic(roughness.max(0.0))));
+    let d = gaussian2(sh, *sigma + SlopeCov::isotropic(roughness.max(0.0)));
     f0 * d * u_h / (4.0 * h.z.powi(4) * wo.z * eu.max(1e-300))
 }
 

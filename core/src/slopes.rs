@@ -44,16 +44,6 @@ impl SlopeCov {
         }
     }
 
-    /// Sum of two independent slope distributions: variances add [HN12 Sec. 5.5]
-    /// (the "σ_n² + σ_n0²" convolution of the NDF with the base BRDF's).
-    pub fn add(self, other: Self) -> Self {
-        Self {
-            xx: self.xx + other.xx,
-            yy: self.yy + other.yy,
-            xy: self.xy + other.xy,
-        }
-    }
-
     /// Scale slopes by `s` (heights scaled by s): the covariance scales by s².
     pub fn scaled(self, s: f64) -> Self {
         let s2 = s * s;
@@ -77,6 +67,19 @@ impl SlopeCov {
     /// Determinant `xx·yy − xy²` (≥ 0 for a valid covariance).
     pub fn det(&self) -> f64 {
         self.xx * self.yy - self.xy * self.xy
+    }
+}
+
+/// Sum of two independent slope distributions: covariances add [HN12 Sec. 5.5]
+/// (the "σ_n² + σ_n0²" convolution of the NDF with the base BRDF's).
+impl std::ops::Add for SlopeCov {
+    type Output = Self;
+    fn add(self, other: Self) -> Self {
+        Self {
+            xx: self.xx + other.xx,
+            yy: self.yy + other.yy,
+            xy: self.xy + other.xy,
+        }
     }
 }
 

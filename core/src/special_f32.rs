@@ -16,7 +16,7 @@ pub const SQRT_PI: f32 = 1.772_453_9;
 /// 1/√(2π) in f32.
 pub const FRAC_1_SQRT_2PI: f32 = 0.398_942_3;
 /// 2/√π in f32.
-pub const FRAC_2_SQRT_PI: f32 = 1.128_379_2;
+pub const FRAC_2_SQRT_PI: f32 = std::f32::consts::FRAC_2_SQRT_PI;
 /// Λ's argument is clamped to at least this (Λ saturates near 2.8e29, finite in f32).
 pub const NU_MIN: f32 = 1e-30;
 const CF_THRESHOLD: f32 = 1.0;

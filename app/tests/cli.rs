@@ -1,0 +1,82 @@
+//! The command line: help, exit codes, error messages with line and column, JSON output.
+
+use std::process::Command;
+
+fn lodestone(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_lodestone"))
+        .args(args)
+        .output()
+        .expect("run lodestone")
+}
+
+#[test]
+fn help_works() {
+    let out = lodestone(&["--help"]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    for sub in ["eval", "validate", "show", "adapter"] {
+        assert!(text.contains(sub), "help lacks {sub}");
+    }
+}
+
+#[test]
+fn malformed_preset_exits_2_with_line_and_column() {
+    let dir = std::env::temp_dir().join(format!("lodestone-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.ron");
+    std::fs::write(&bad, "Material(\n    version: 1,\n    name: \"x\",\n    driver: Noise(()),\n    heights: (sigma_h: nope),\n)").unwrap();
+    let out = lodestone(&["validate", "--preset", bad.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("bad.ron") && err.contains("line 5"), "{err}");
+    let invalid = dir.join("invalid.ron");
+    let text = include_str!("../../presets/default.ron")
+        .replace("sigma_h: 0.05", "sigma_h: -1.0")
+        .replace("albedo: 1.0", "albedo: 7.0");
+    std::fs::write(&invalid, text).unwrap();
+    let out = lodestone(&["validate", "--preset", invalid.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("heights.sigma_h") && err.contains("brdf.albedo"),
+        "every problem listed: {err}"
+    );
+    let out = lodestone(&[
+        "validate",
+        "--preset",
+        dir.join("missing.ron").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+}
+
+#[test]
+fn eval_prints_json_with_every_method() {
+    let out = lodestone(&[
+        "eval",
+        "--view-deg",
+        "45",
+        "--light-deg",
+        "20",
+        "--spp",
+        "2000",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
+    for key in [
+        "naive",
+        "view_independent",
+        "filtered",
+        "ground_truth",
+        "ground_truth_std_error",
+    ] {
+        let arr = v[key].as_array().unwrap_or_else(|| panic!("{key} missing"));
+        assert_eq!(arr.len(), 3);
+        assert!(arr.iter().all(|c| c.as_f64().unwrap().is_finite()));
+    }
+    assert_eq!(v["samples"].as_u64(), Some(2000));
+}
