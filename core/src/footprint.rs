@@ -14,7 +14,7 @@
 //!   effective height distribution D_h [HNPN14 Eqs. 14–17] (exact table or fits), with masking L from
 //!   the unresolved slopes (correlated or not) [HNPN14 Eq. 12]; the HN12 attribute model uses its closed
 //!   form [HN12 Eq. 17]; ρ̄_d is the clamped cosine averaged over the visible slope distribution
-//!   D_s ∝ p(s)·(ωo_z − s·ωo_xy)⁺ [HNPN14 Sec. 5.2] by 24×24 Gauss–Hermite, and ρ̄_s the Beckmann lobe
+//!   D_s ∝ p(s)·(ωo_z − s·ωo_xy)⁺ [HNPN14 Sec. 5.2] by n×n Gauss–Hermite (n = 8 by default), and ρ̄_s the Beckmann lobe
 //!   widened by the unresolved slopes (σ_n² + σ_n0² [HN12 Sec. 5.5]). Transfer functions enter
 //!   through their moment tables [HNPN14 Eqs. 21–26].
 //! * **Ground truth**: eye rays through points drawn from `w_P`, marched onto the explicit surface
@@ -276,8 +276,10 @@ impl Prepared {
             0.0
         };
         let brdf = &self.material.brdf;
-        let diffuse =
-            brdf.albedo * FRAC_1_PI * visible_slope_mean(&sigma, wo, |n| n.dot(wi).max(0.0));
+        let points = f.slope_points as usize;
+        let diffuse = brdf.albedo
+            * FRAC_1_PI
+            * visible_slope_mean(&sigma, wo, points, |n| n.dot(wi).max(0.0));
         let spec = filtered_specular(brdf.specular, brdf.roughness, &sigma, wo, wi);
         color.map(|c| vbar * (c * diffuse + spec))
     }
@@ -399,12 +401,18 @@ fn cholesky(xx: f64, xy: f64, yy: f64) -> (f64, f64, f64) {
     (l11, l21, (yy - l21 * l21).max(0.0).sqrt())
 }
 
-/// E over the visible slope distribution D_s ∝ N(s; 0, Σ)·(ωo_z − s·ωo_xy)⁺ [HNPN14 Sec. 5.2] of
-/// q(n(s)), by 24×24 Gauss–Hermite over N(0, Σ).
-pub fn visible_slope_mean(sigma: &SlopeCov, wo: DVec3, q: impl Fn(DVec3) -> f64) -> f64 {
+/// Gauss–Hermite rules for N(0, 1), cached per order (1..=32).
+pub fn hermite_rule(n: usize) -> &'static (Vec<f64>, Vec<f64>) {
     use std::sync::OnceLock;
-    static GH: OnceLock<(Vec<f64>, Vec<f64>)> = OnceLock::new();
-    let (x, w) = GH.get_or_init(|| gauss_hermite_normal(24));
+    static RULES: [OnceLock<(Vec<f64>, Vec<f64>)>; 32] = [const { OnceLock::new() }; 32];
+    let n = n.clamp(1, 32);
+    RULES[n - 1].get_or_init(|| gauss_hermite_normal(n))
+}
+
+/// E over the visible slope distribution D_s ∝ N(s; 0, Σ)·(ωo_z − s·ωo_xy)⁺ [HNPN14 Sec. 5.2] of
+/// q(n(s)), by n×n Gauss–Hermite over N(0, Σ) (the material's `filtering.slope_points`).
+pub fn visible_slope_mean(sigma: &SlopeCov, wo: DVec3, n: usize, q: impl Fn(DVec3) -> f64) -> f64 {
+    let (x, w) = hermite_rule(n);
     let (l11, l21, l22) = cholesky(sigma.xx, sigma.xy, sigma.yy);
     let (mut num, mut den) = (0.0, 0.0);
     for (xa, wa) in x.iter().zip(w) {

@@ -10,6 +10,7 @@
 
 pub mod attribute;
 pub mod brdf;
+pub mod camera;
 pub mod colormap;
 pub mod effective_height;
 pub mod footprint;

@@ -90,7 +90,7 @@ pub struct Slopes {
 }
 
 /// Filtering options of the filtered view.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Filtering {
     /// Masking–shadowing combination (correlated by default).
@@ -99,6 +99,27 @@ pub struct Filtering {
     pub height_filter: HeightFilter,
     /// Size and σ range of the pre-convolved tables.
     pub table: TableSpec,
+    /// Gauss–Hermite points per axis for averages over the visible slope distribution D_s
+    /// (the GPU evaluates n² points per pixel).
+    pub slope_points: u32,
+}
+
+impl Default for Filtering {
+    fn default() -> Self {
+        Self {
+            correlation: Correlation::default(),
+            height_filter: HeightFilter::default(),
+            table: TableSpec::default(),
+            slope_points: Self::DEFAULT_SLOPE_POINTS,
+        }
+    }
+}
+
+impl Filtering {
+    /// Default Gauss–Hermite order per axis.
+    pub const DEFAULT_SLOPE_POINTS: u32 = 8;
+    /// Largest accepted order.
+    pub const MAX_SLOPE_POINTS: u32 = 32;
 }
 
 /// A material.
@@ -278,6 +299,13 @@ impl Material {
             }
         }
         p.in_range("filtering.table.sigma_max", t.sigma_max, 1e-3, 100.0);
+        let sp = self.filtering.slope_points;
+        if !(1..=Filtering::MAX_SLOPE_POINTS).contains(&sp) {
+            p.push(
+                "filtering.slope_points",
+                format!("must be in 1..={}, got {sp}", Filtering::MAX_SLOPE_POINTS),
+            );
+        }
         if p.0.is_empty() { Ok(()) } else { Err(p.0) }
     }
 
