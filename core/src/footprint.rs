@@ -342,21 +342,31 @@ impl Prepared {
 
     /// One eye ray through the mean-plane point y: its radiance.
     fn trace_pixel_sample(&self, y: DVec2, cfg: &Config) -> [f64; 3] {
-        let s = &self.surface;
-        let lift = (s.h_max * 1.001 + 1e-9) / cfg.wo.z;
-        let o = DVec3::new(y.x, y.y, 0.0) + cfg.wo * lift;
-        let Trace::Hit(t) = s.march(o, -cfg.wo) else {
-            return [0.0; 3];
-        };
-        let p = o - cfg.wo * t;
-        let (f, _h, grad) = s.sample(DVec2::new(p.x, p.y));
-        let n = normal_of(grad);
-        if n.dot(cfg.wi) <= 0.0 || cfg.wi.z <= 0.0 || !s.sees(p, cfg.wi) {
+        let origin = DVec3::new(y.x, y.y, 0.0) + cfg.wo * 1.0;
+        self.trace_ray(origin, -cfg.wo, cfg.wi)
+    }
+
+    /// Radiance along a camera ray (origin, unit direction) toward light ωi: the ray starts on the
+    /// top of the surface's slab, is marched onto the explicit surface, shaded with the base BRDF at
+    /// the true micro-normal, and lit only if a real shadow ray reaches the light.
+    pub fn trace_ray(&self, origin: DVec3, dir: DVec3, wi: DVec3) -> [f64; 3] {
+        if dir.z >= 0.0 {
             return [0.0; 3];
         }
-        self.material
-            .brdf
-            .shade(self.color_at(f), n, cfg.wo, cfg.wi)
+        let s = &self.surface;
+        let top = s.h_max * 1.001 + 1e-6;
+        let t0 = ((origin.z - top) / -dir.z).max(0.0);
+        let o = origin + dir * t0;
+        let Trace::Hit(t) = s.march(o, dir) else {
+            return [0.0; 3];
+        };
+        let p = o + dir * t;
+        let (f, _h, grad) = s.sample(DVec2::new(p.x, p.y));
+        let n = normal_of(grad);
+        if n.dot(wi) <= 0.0 || wi.z <= 0.0 || !s.sees(p, wi) {
+            return [0.0; 3];
+        }
+        self.material.brdf.shade(self.color_at(f), n, -dir, wi)
     }
 }
 

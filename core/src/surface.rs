@@ -26,10 +26,10 @@ pub struct Surface {
     pub transfer: TransferFunction,
     /// Rigorous bound on |h|.
     pub h_max: f64,
-    /// max |g′|.
-    g_lip: f64,
-    /// Minimum step length.
-    min_step: f64,
+    /// max |g′| (Lipschitz constant of g).
+    pub g_lip: f64,
+    /// Minimum step length of the march.
+    pub min_step: f64,
 }
 
 /// Result of marching a ray.
@@ -85,7 +85,8 @@ impl Surface {
     }
 
     /// March `p(t) = o + t·d` (d unit) from t = 0 while it is above the surface; `Hit(t)` at the first
-    /// crossing. `o` must be on or above the surface.
+    /// crossing. `o` must be on or above the surface; a negative gap at `o` itself is taken as rounding
+    /// (a shadow ray leaving a hit point), never as a crossing.
     pub fn march(&self, o: DVec3, d: DVec3) -> Trace {
         let dxy = DVec2::new(d.x, d.y);
         let r = dxy.length();
@@ -107,9 +108,14 @@ impl Surface {
             if (d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < bottom - 1.0) {
                 return Trace::Escape;
             }
-            let gap = p.z - self.height(DVec2::new(p.x, p.y));
+            let mut gap = p.z - self.height(DVec2::new(p.x, p.y));
             if gap < 0.0 {
-                return Trace::Hit(self.bisect(o, d, prev, t));
+                if t == 0.0 {
+                    // The origin is on the surface by contract: a negative gap here is rounding.
+                    gap = 0.0;
+                } else {
+                    return Trace::Hit(self.bisect(o, d, prev, t));
+                }
             }
             prev = t;
             t += (gap / rate).max(self.min_step);

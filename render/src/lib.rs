@@ -6,6 +6,9 @@
 
 pub mod compute;
 pub mod gpu;
+pub mod gpu_types;
+pub mod renderer;
 pub mod shaders;
 
 pub use gpu::{GpuContext, GpuError};
+pub use renderer::{GpuMaterial, LinearImage, Renderer, Scene, ViewMode};

@@ -3,8 +3,27 @@
 /// f32 special functions, mirroring `lodestone_core::special_f32`.
 pub const SPECIAL: &str = include_str!("shaders/special.wgsl");
 
-/// Every WGSL source with its file name.
-pub const ALL: &[(&str, &str)] = &[("special.wgsl", SPECIAL)];
+/// The material model (mirrors of core's noise, transfer, tables, Smith, BRDF and footprint code).
+pub const MATERIAL: &str = include_str!("shaders/material.wgsl");
+
+/// The view pass (camera rays, footprints, modes, progressive ground truth).
+pub const VIEW: &str = include_str!("shaders/view.wgsl");
+
+/// Every WGSL source with its file name; each is validated together with the files it needs.
+pub const ALL: &[(&str, &str)] = &[
+    ("special.wgsl", SPECIAL),
+    ("material.wgsl", MATERIAL),
+    ("view.wgsl", VIEW),
+];
+
+/// The sources a file needs before it (WGSL has no includes; files are concatenated in this order).
+pub fn prelude_for(name: &str) -> Vec<&'static str> {
+    match name {
+        "material.wgsl" => vec![SPECIAL],
+        "view.wgsl" => vec![SPECIAL, MATERIAL],
+        _ => vec![],
+    }
+}
 
 /// Names of the functions `special.wgsl` mirrors from `lodestone_core::special_f32` (same names).
 pub const SPECIAL_MIRRORED: &[&str] = &[

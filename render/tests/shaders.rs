@@ -4,17 +4,26 @@
 use lodestone_core::{special, special_f32};
 use lodestone_render::{GpuContext, compute::eval_unary, shaders};
 
+/// Parse and validate a file together with the files it needs.
+fn module_for(name: &str, file: &str) -> naga::Module {
+    let mut parts = shaders::prelude_for(name);
+    parts.push(file);
+    let src = parts.join("\n");
+    let module = naga::front::wgsl::parse_str(&src)
+        .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
+    naga::valid::Validator::new(
+        naga::valid::ValidationFlags::all(),
+        naga::valid::Capabilities::all(),
+    )
+    .validate(&module)
+    .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+    module
+}
+
 #[test]
 fn every_wgsl_file_validates() {
-    for (name, src) in shaders::ALL {
-        let module = naga::front::wgsl::parse_str(src)
-            .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(src)));
-        naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::all(),
-        )
-        .validate(&module)
-        .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+    for (name, file) in shaders::ALL {
+        let module = module_for(name, file);
         // The mirrored functions exist under core's names.
         if *name == "special.wgsl" {
             for f in shaders::SPECIAL_MIRRORED {
@@ -28,6 +37,33 @@ fn every_wgsl_file_validates() {
             }
         }
     }
+}
+
+#[test]
+fn gpu_params_match_the_wgsl_layout() {
+    let module = module_for("material.wgsl", shaders::MATERIAL);
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).expect("layout");
+    let (handle, ty) = module
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some("Params"))
+        .expect("struct Params");
+    let naga::TypeInner::Struct { members, span } = &ty.inner else {
+        panic!("Params is not a struct")
+    };
+    let rust = lodestone_render::gpu_types::gpu_params_offsets();
+    assert_eq!(members.len(), rust.len(), "field count");
+    for (m, (name, off)) in members.iter().zip(&rust) {
+        assert_eq!(m.name.as_deref(), Some(*name), "field order");
+        assert_eq!(m.offset as usize, *off, "offset of {name}");
+    }
+    assert_eq!(
+        *span as usize,
+        std::mem::size_of::<lodestone_render::gpu_types::GpuParams>(),
+        "size"
+    );
+    let _ = layouter[handle].size;
 }
 
 fn inputs(lo: f32, hi: f32, n: usize, extremes: &[f32]) -> Vec<f32> {

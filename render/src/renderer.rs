@@ -1,0 +1,397 @@
+//! The plane scene rendered under every view mode by one compute pass per frame, with readback to
+//! linear f32 and 8-bit sRGB images. One accumulation target per view.
+
+use crate::gpu::GpuContext;
+use crate::gpu_types::GpuParams;
+use crate::shaders;
+use glam::DVec3;
+use lodestone_core::camera::{Camera, PIXEL_SIGMA};
+use lodestone_core::colormap::linear_to_srgb;
+use lodestone_core::effective_height::{EffectiveHeightTable, HeightFilter};
+use lodestone_core::footprint::{Prepared, hermite_rule};
+use lodestone_core::material::{ColorModel, ColorSource};
+use lodestone_core::piecewise::PiecewisePoly;
+use lodestone_core::preconvolved::PreconvolvedTable;
+use lodestone_core::shadowing::Correlation;
+use lodestone_core::transfer::TransferFunction;
+use std::f64::consts::TAU;
+
+/// What a view shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ViewMode {
+    /// Colour map of the filtered driver, filtered normal, no masking [HNPN14 Sec. 9].
+    Naive,
+    /// Exact footprint average of the colour, no masking.
+    ViewIndependent,
+    /// The papers' filtering.
+    Filtered,
+    /// Ray-traced explicit micro-geometry.
+    Truth,
+}
+
+impl ViewMode {
+    fn code(self) -> u32 {
+        match self {
+            Self::Naive => 0,
+            Self::ViewIndependent => 1,
+            Self::Filtered => 2,
+            Self::Truth => 3,
+        }
+    }
+}
+
+/// Camera and light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scene {
+    /// The camera.
+    pub camera: Camera,
+    /// Unit direction toward the light.
+    pub light: DVec3,
+}
+
+/// A linear-RGB image; `pixels[i][3]` is the sample count (1 for the analytic views).
+#[derive(Clone, Debug, PartialEq)]
+pub struct LinearImage {
+    /// Width.
+    pub width: u32,
+    /// Height.
+    pub height: u32,
+    /// Row-major RGB + weight.
+    pub pixels: Vec<[f32; 4]>,
+}
+
+impl LinearImage {
+    /// Linear RGB of pixel (x, y), divided by its weight.
+    pub fn rgb(&self, x: u32, y: u32) -> [f32; 3] {
+        let p = self.pixels[(y * self.width + x) as usize];
+        let w = if p[3] > 0.0 { p[3] } else { 1.0 };
+        [p[0] / w, p[1] / w, p[2] / w]
+    }
+
+    /// 8-bit sRGB, opaque.
+    pub fn to_srgb8(&self) -> image::RgbaImage {
+        image::RgbaImage::from_fn(self.width, self.height, |x, y| {
+            let c = self
+                .rgb(x, y)
+                .map(|v| (linear_to_srgb(f64::from(v)) * 255.0).round() as u8);
+            image::Rgba([c[0], c[1], c[2], 255])
+        })
+    }
+
+    /// Linear RGBA f32 (alpha 1), for EXR.
+    pub fn to_linear_f32(&self) -> image::Rgba32FImage {
+        image::Rgba32FImage::from_fn(self.width, self.height, |x, y| {
+            let c = self.rgb(x, y);
+            image::Rgba([c[0], c[1], c[2], 1.0])
+        })
+    }
+}
+
+/// Offsets (in f32 units) of each table in the material's data buffer.
+#[derive(Clone, Copy, Debug, Default)]
+struct Layout {
+    waves: u32,
+    color_table: u32,
+    transfer_table: u32,
+    dh: u32,
+    gh: u32,
+    color_poly: u32,
+    transfer_poly: u32,
+}
+
+/// A material uploaded for the GPU: its data buffer and the constant part of its parameters.
+#[derive(Debug)]
+pub struct GpuMaterial {
+    data: wgpu::Buffer,
+    base: GpuParams,
+    target: [f64; 2],
+}
+
+/// The renderer: one compute pipeline for every mode.
+#[derive(Debug)]
+pub struct Renderer {
+    ctx: GpuContext,
+    pipeline: wgpu::ComputePipeline,
+}
+
+/// The WGSL the view pass compiles: special functions, material model, view entry point.
+pub fn view_source() -> String {
+    [shaders::SPECIAL, shaders::MATERIAL, shaders::VIEW].join("\n")
+}
+
+fn push_table(data: &mut Vec<f32>, t: &PreconvolvedTable) -> u32 {
+    let off = data.len() as u32;
+    data.extend(t.texels.iter().flatten());
+    off
+}
+
+/// Knots, then per segment and channel 4 coefficients (degree ≤ 3), then left and right tails.
+fn push_poly(data: &mut Vec<f32>, p: &PiecewisePoly, channels: &[usize]) -> u32 {
+    let off = data.len() as u32;
+    data.extend(p.knots.iter().map(|k| *k as f32));
+    for seg in 0..p.segments() {
+        for &ch in channels {
+            let c = &p.coeffs[seg * p.channels + ch];
+            data.extend(c[..4].iter().map(|v| *v as f32));
+        }
+    }
+    data.extend(channels.iter().map(|&ch| p.left[ch] as f32));
+    data.extend(channels.iter().map(|&ch| p.right[ch] as f32));
+    off
+}
+
+impl GpuMaterial {
+    /// Upload a prepared material with coordinates relative to `target` (the camera target): each
+    /// wave's phase absorbs 2π k·target in f64, so f32 phases stay accurate anywhere on the plane.
+    pub fn new(ctx: &GpuContext, prepared: &Prepared, target: [f64; 2]) -> Self {
+        let m = &prepared.material;
+        let s = &prepared.surface;
+        let mut data: Vec<f32> = Vec::new();
+        let mut lay = Layout {
+            waves: 0,
+            ..Layout::default()
+        };
+        for w in &s.noise.waves {
+            let phase = (w.phase + TAU * (w.k.x * target[0] + w.k.y * target[1])).rem_euclid(TAU);
+            data.extend([w.k.x as f32, w.k.y as f32, w.amplitude as f32, phase as f32]);
+        }
+        let mut base = GpuParams {
+            wave_count: s.noise.waves.len() as u32,
+            ..GpuParams::default()
+        };
+        if let Some(t) = &prepared.color_table {
+            lay.color_table = push_table(&mut data, t);
+            base.ct_size_m = t.size_m as u32;
+            base.ct_size_s = t.size_sigma as u32;
+            base.ct_m_min = t.m_min as f32;
+            base.ct_m_max = t.m_max as f32;
+            base.ct_sigma_max = t.sigma_max as f32;
+        }
+        if let Some(t) = &prepared.transfer_table {
+            lay.transfer_table = push_table(&mut data, t);
+            base.tt_size_m = t.size_m as u32;
+            base.tt_size_s = t.size_sigma as u32;
+            base.tt_m_min = t.m_min as f32;
+            base.tt_m_max = t.m_max as f32;
+            base.tt_sigma_max = t.sigma_max as f32;
+        }
+        let dh = EffectiveHeightTable::shared();
+        lay.dh = data.len() as u32;
+        for (a, b) in dh.mean.iter().zip(&dh.std) {
+            data.extend([*a as f32, *b as f32]);
+        }
+        let points = m.filtering.slope_points.max(1) as usize;
+        let (x, w) = hermite_rule(points);
+        lay.gh = data.len() as u32;
+        for (a, b) in x.iter().zip(w) {
+            data.extend([*a as f32, *b as f32]);
+        }
+        match &m.color {
+            ColorModel::Gradient { map, source } => {
+                let p = map.to_piecewise();
+                lay.color_poly = push_poly(&mut data, &p, &[0, 1, 2]);
+                base.cp_knots = p.knots.len() as u32;
+                base.color_kind = match source {
+                    ColorSource::Driver => 0,
+                    ColorSource::Height => 1,
+                };
+            }
+            ColorModel::Attribute { mean, correlation } => {
+                base.color_kind = 2;
+                base.attr_mean = mean.map(|v| v as f32);
+                base.attr_corr = correlation.map(|v| v as f32);
+            }
+        }
+        if let TransferFunction::Curve(c) = &m.heights.transfer {
+            let p = c.moment_poly();
+            lay.transfer_poly = push_poly(&mut data, &p, &[0, 2]);
+            base.tp_knots = p.knots.len() as u32;
+            base.transfer_kind = 1;
+        }
+        if data.is_empty() {
+            data.push(0.0);
+        }
+        base.waves_offset = lay.waves;
+        base.ct_offset = lay.color_table;
+        base.tt_offset = lay.transfer_table;
+        base.dh_offset = lay.dh;
+        base.dh_size = dh.mean.len() as u32;
+        base.dh_ln_min = dh.ln_l_min as f32;
+        base.dh_ln_max = dh.ln_l_max as f32;
+        base.gh_offset = lay.gh;
+        base.slope_points = points as u32;
+        base.cp_offset = lay.color_poly;
+        base.tp_offset = lay.transfer_poly;
+        base.sigma_h = s.sigma_h as f32;
+        base.albedo = m.brdf.albedo as f32;
+        base.specular = m.brdf.specular as f32;
+        base.roughness = m.brdf.roughness as f32;
+        base.h_max = s.h_max as f32;
+        base.g_lip = s.g_lip as f32;
+        base.min_step = s.min_step as f32;
+        base.correlation = u32::from(m.filtering.correlation == Correlation::HeightDirection);
+        base.height_filter = u32::from(m.filtering.height_filter == HeightFilter::PaperFit);
+        base.g_mean = prepared.g_global.0 as f32;
+        base.g_std = prepared.g_global.1 as f32;
+        let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("material data"),
+            size: (data.len() * 4) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        ctx.queue
+            .write_buffer(&buffer, 0, bytemuck::cast_slice(&data));
+        Self {
+            data: buffer,
+            base,
+            target,
+        }
+    }
+
+    /// The camera target the data was uploaded for.
+    pub fn target(&self) -> [f64; 2] {
+        self.target
+    }
+}
+
+impl Renderer {
+    /// Compile the view pipeline on `ctx`.
+    pub fn new(ctx: GpuContext) -> Self {
+        let module = ctx
+            .device
+            .create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("view"),
+                source: wgpu::ShaderSource::Wgsl(view_source().into()),
+            });
+        let pipeline = ctx
+            .device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("view"),
+                layout: None,
+                module: &module,
+                entry_point: Some("view_main"),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+        Self { ctx, pipeline }
+    }
+
+    /// The GPU context.
+    pub fn context(&self) -> &GpuContext {
+        &self.ctx
+    }
+
+    /// Render `mode` at `width × height`. Ground truth accumulates `samples` frames of one ray per
+    /// pixel, stratified over a ⌈√samples⌉² grid of the pixel filter; the analytic modes ignore it.
+    pub fn render(
+        &self,
+        material: &GpuMaterial,
+        scene: &Scene,
+        mode: ViewMode,
+        (width, height): (u32, u32),
+        samples: u32,
+    ) -> LinearImage {
+        let samples = samples.max(1);
+        let spp_side = (f64::from(samples).sqrt().ceil() as u32).max(1);
+        let device = &self.ctx.device;
+        let mut params = material.base;
+        let cam = Camera {
+            target: [0.0, 0.0],
+            ..scene.camera
+        };
+        let (r, u, f) = cam.basis();
+        let eye = cam.eye();
+        let v3 = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32];
+        params.eye = v3(eye);
+        params.right = v3(r);
+        params.up = v3(u);
+        params.forward = v3(f);
+        params.light = v3(scene.light.normalize());
+        params.tan_half_fov =
+            (scene.camera.fov_deg.clamp(1e-3, 120.0).to_radians() * 0.5).tan() as f32;
+        params.aspect = (f64::from(width) / f64::from(height.max(1))) as f32;
+        params.pixel_sigma = PIXEL_SIGMA as f32;
+        params.width = width;
+        params.height = height;
+        params.mode = mode.code();
+        params.spp_side = spp_side.max(1);
+        let param_buf = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("params"),
+            size: std::mem::size_of::<GpuParams>() as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let size = u64::from(width) * u64::from(height) * 16;
+        let accum = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("accumulation"),
+            size,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("view"),
+            layout: &self.pipeline.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: param_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: material.data.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: accum.as_entire_binding(),
+                },
+            ],
+        });
+        let frames = if mode == ViewMode::Truth { samples } else { 1 };
+        for frame in 0..frames {
+            params.frame = frame;
+            self.ctx
+                .queue
+                .write_buffer(&param_buf, 0, bytemuck::bytes_of(&params));
+            let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("view"),
+            });
+            {
+                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("view"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &bind, &[]);
+                pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+            }
+            self.ctx.queue.submit([enc.finish()]);
+        }
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("readback"),
+        });
+        enc.copy_buffer_to_buffer(&accum, 0, &readback, 0, size);
+        self.ctx.queue.submit([enc.finish()]);
+        let slice = readback.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |r| r.expect("map readback"));
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("device poll");
+        let view = slice.get_mapped_range().expect("mapped range");
+        let floats: &[f32] = bytemuck::cast_slice(&view);
+        let pixels = floats
+            .chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect();
+        LinearImage {
+            width,
+            height,
+            pixels,
+        }
+    }
+}

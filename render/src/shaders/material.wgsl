@@ -1,0 +1,599 @@
+// The material model on the GPU: the WGSL mirror of lodestone-core's noise.rs, transfer.rs,
+// preconvolved.rs, effective_height.rs, smith.rs, shadowing.rs, attribute.rs, brdf.rs and
+// footprint.rs, function for function under the same names (prefixes only where WGSL needs them).
+// Needs special.wgsl before it. All positions are relative to the camera target (the CPU folds
+// 2π k·target into each wave's phase in f64), which keeps f32 phases accurate far from the origin.
+
+const PI: f32 = 3.14159265;
+const TAU: f32 = 6.2831853;
+const FRAC_1_PI: f32 = 0.31830988;
+const SQRT_2: f32 = 1.4142135;
+
+// Flat parameter block; kept in sync with `GpuParams` in gpu_types.rs by a layout test.
+struct Params {
+    eye: vec3<f32>,
+    tan_half_fov: f32,
+    right: vec3<f32>,
+    aspect: f32,
+    up: vec3<f32>,
+    pixel_sigma: f32,
+    forward: vec3<f32>,
+    frame: u32,
+    light: vec3<f32>,
+    mode: u32,
+    attr_mean: vec3<f32>,
+    dh_ln_min: f32,
+    attr_corr: vec3<f32>,
+    dh_ln_max: f32,
+    width: u32,
+    height: u32,
+    spp_side: u32,
+    wave_count: u32,
+    sigma_h: f32,
+    albedo: f32,
+    specular: f32,
+    roughness: f32,
+    h_max: f32,
+    g_lip: f32,
+    min_step: f32,
+    transfer_kind: u32,
+    color_kind: u32,
+    correlation: u32,
+    height_filter: u32,
+    slope_points: u32,
+    g_mean: f32,
+    g_std: f32,
+    dh_size: u32,
+    gh_offset: u32,
+    ct_offset: u32,
+    ct_size_m: u32,
+    ct_size_s: u32,
+    ct_m_min: f32,
+    ct_m_max: f32,
+    ct_sigma_max: f32,
+    tt_offset: u32,
+    tt_size_m: u32,
+    tt_size_s: u32,
+    tt_m_min: f32,
+    tt_m_max: f32,
+    tt_sigma_max: f32,
+    cp_offset: u32,
+    cp_knots: u32,
+    tp_offset: u32,
+    tp_knots: u32,
+    waves_offset: u32,
+    dh_offset: u32,
+    pad0: u32,
+    pad1: u32,
+}
+
+@group(0) @binding(0) var<storage, read> params: Params;
+@group(0) @binding(1) var<storage, read> data: array<f32>;
+
+// ---------------------------------------------------------------- preconvolved.rs
+fn texel4(off: u32, i: u32) -> vec4<f32> {
+    let b = off + 4u * i;
+    return vec4<f32>(data[b], data[b + 1u], data[b + 2u], data[b + 3u]);
+}
+
+// (i0, i1, blend) of a continuous texel coordinate, clamped (mirror of preconvolved::split).
+fn split_coord(f_in: f32, n: u32) -> vec3<f32> {
+    let f = clamp(f_in, 0.0, f32(n - 1u));
+    let i0 = min(u32(floor(f)), n - 2u);
+    return vec3<f32>(f32(i0), f32(i0 + 1u), f - f32(i0));
+}
+
+// PreconvolvedTable::sample: bilinear, clamp-to-edge.
+fn table_sample(off: u32, nm: u32, ns: u32, m_min: f32, m_max: f32, sigma_max: f32, m: f32, sigma: f32) -> vec4<f32> {
+    let u = split_coord((m - m_min) / (m_max - m_min) * f32(nm - 1u), nm);
+    let v = split_coord(sigma / sigma_max * f32(ns - 1u), ns);
+    let i0 = u32(u.x);
+    let i1 = u32(u.y);
+    let j0 = u32(v.x);
+    let j1 = u32(v.y);
+    let top = mix(texel4(off, j0 * nm + i0), texel4(off, j0 * nm + i1), u.z);
+    let bot = mix(texel4(off, j1 * nm + i0), texel4(off, j1 * nm + i1), u.z);
+    return mix(top, bot, v.z);
+}
+
+// ---------------------------------------------------------------- effective_height.rs
+// EffectiveHeightTable::lookup (x = mean, y = std), or the paper's fits [HNPN14 Eqs. 16–17].
+fn height_moments(l_in: f32) -> vec2<f32> {
+    let l = max(l_in, 0.0);
+    if (params.height_filter == 1u) {
+        let lc = min(l, 1e30);
+        return vec2<f32>(0.39 * log(1.0 + 4.75 * lc), 1.0 / (1.0 + 0.26 * log(1.0 + 1.13 * lc)));
+    }
+    let n = params.dh_size;
+    let off = params.dh_offset;
+    let l_min = exp(params.dh_ln_min);
+    if (l < l_min) {
+        let s = l / l_min;
+        return vec2<f32>(s * data[off], 1.0 + s * (data[off + 1u] - 1.0));
+    }
+    let u = clamp((log(l) - params.dh_ln_min) / (params.dh_ln_max - params.dh_ln_min) * f32(n - 1u), 0.0, f32(n - 1u));
+    let i = min(u32(floor(u)), n - 2u);
+    let f = u - f32(i);
+    let a = vec2<f32>(data[off + 2u * i], data[off + 2u * i + 1u]);
+    let b = vec2<f32>(data[off + 2u * i + 2u], data[off + 2u * i + 3u]);
+    return mix(a, b, f);
+}
+
+// ---------------------------------------------------------------- piecewise.rs (eval, degree ≤ 3)
+// Layout at `off`: knots[k], then per segment per channel 4 coefficients, then left[ch], right[ch].
+fn poly_eval(off: u32, k: u32, channels: u32, ch: u32, x: f32) -> f32 {
+    let coeff = off + k;
+    let tails = coeff + 4u * channels * (k - 1u);
+    if (x < data[off]) {
+        return data[tails + ch];
+    }
+    if (x >= data[off + k - 1u]) {
+        return data[tails + channels + ch];
+    }
+    // Last knot ≤ x.
+    var seg = 0u;
+    for (var i = 1u; i < k - 1u; i = i + 1u) {
+        if (data[off + i] <= x) {
+            seg = i;
+        }
+    }
+    let a = data[off + seg];
+    let b = data[off + seg + 1u];
+    let t = (x - a) / (b - a);
+    let c = coeff + 4u * (seg * channels + ch);
+    return ((data[c + 3u] * t + data[c + 2u]) * t + data[c + 1u]) * t + data[c];
+}
+
+// ---------------------------------------------------------------- noise.rs
+struct FilteredDriver {
+    mean: f32,
+    std_dev: f32,
+    mean_gradient: vec2<f32>,
+    gradient_cov: vec3<f32>, // xx, yy, xy
+}
+
+fn wave(i: u32) -> vec4<f32> {
+    return texel4(params.waves_offset, i);
+}
+
+// SumOfSines::value_and_gradient: (f, ∂f/∂x, ∂f/∂y).
+fn value_and_gradient(x: vec2<f32>) -> vec3<f32> {
+    var v = 0.0;
+    var g = vec2<f32>(0.0);
+    for (var i = 0u; i < params.wave_count; i = i + 1u) {
+        let w = wave(i);
+        let ph = TAU * dot(w.xy, x) + w.w;
+        v = v + w.z * cos(ph);
+        g = g - w.xy * (w.z * TAU * sin(ph));
+    }
+    return vec3<f32>(v, g);
+}
+
+// SumOfSines::filtered with footprint covariance (xx, yy, xy).
+fn filtered_driver(x: vec2<f32>, fp: vec3<f32>) -> FilteredDriver {
+    var r: FilteredDriver;
+    r.mean = 0.0;
+    r.mean_gradient = vec2<f32>(0.0);
+    r.gradient_cov = vec3<f32>(0.0);
+    var var_sum = 0.0;
+    for (var i = 0u; i < params.wave_count; i = i + 1u) {
+        let w = wave(i);
+        let q = w.x * w.x * fp.x + 2.0 * w.x * w.y * fp.z + w.y * w.y * fp.y;
+        let g = exp(-2.0 * PI * PI * q);
+        let ph = TAU * dot(w.xy, x) + w.w;
+        r.mean = r.mean + w.z * g * cos(ph);
+        r.mean_gradient = r.mean_gradient - w.xy * (w.z * g * TAU * sin(ph));
+        let u = w.z * w.z * (1.0 - g * g) * 0.5;
+        var_sum = var_sum + u;
+        r.gradient_cov = r.gradient_cov + vec3<f32>(w.x * w.x, w.y * w.y, w.x * w.y) * (u * TAU * TAU);
+    }
+    r.std_dev = sqrt(max(var_sum, 0.0));
+    return r;
+}
+
+// ---------------------------------------------------------------- transfer.rs
+// TransferFunction::eval and ::derivative: (g, g′). Identity when transfer_kind == 0.
+fn transfer_eval(f: f32) -> vec2<f32> {
+    if (params.transfer_kind == 0u) {
+        return vec2<f32>(f, 1.0);
+    }
+    return vec2<f32>(poly_eval(params.tp_offset, params.tp_knots, 2u, 0u, f), poly_eval(params.tp_offset, params.tp_knots, 2u, 1u, f));
+}
+
+// Moments (ḡ, σ_g, ḡ′, σ_g′) [HNPN14 Eqs. 21–28], from the table for curves.
+fn transfer_moments(m: f32, s: f32) -> vec4<f32> {
+    if (params.transfer_kind == 0u) {
+        return vec4<f32>(m, max(s, 0.0), 1.0, 0.0);
+    }
+    let v = table_sample(params.tt_offset, params.tt_size_m, params.tt_size_s, params.tt_m_min, params.tt_m_max, params.tt_sigma_max, m, s);
+    return vec4<f32>(v.x, max(v.y, 0.0), v.z, max(v.w, 0.0));
+}
+
+struct SurfaceStats {
+    height_mean: f32,
+    height_std: f32,
+    slope_mean: vec2<f32>,
+    slope_cov: vec3<f32>,
+}
+
+// transformed_statistics [HNPN14 Eqs. 19–26].
+fn transformed_statistics(tm: vec4<f32>, sigma_h: f32, grad_mean: vec2<f32>, grad_cov: vec3<f32>) -> SurfaceStats {
+    let var_d = tm.w * tm.w;
+    let md2 = tm.z * tm.z;
+    let second = grad_cov + vec3<f32>(grad_mean.x * grad_mean.x, grad_mean.y * grad_mean.y, grad_mean.x * grad_mean.y);
+    var s: SurfaceStats;
+    s.slope_cov = (second * var_d + grad_cov * md2) * (sigma_h * sigma_h);
+    s.height_mean = sigma_h * tm.x;
+    s.height_std = abs(sigma_h) * tm.y;
+    s.slope_mean = grad_mean * (sigma_h * tm.z);
+    return s;
+}
+
+// ---------------------------------------------------------------- smith.rs / shadowing.rs
+fn cot_theta(w: vec3<f32>) -> f32 {
+    if (!(w.z > 0.0)) {
+        return 0.0;
+    }
+    let r = length(w.xy);
+    if (r == 0.0) {
+        return 3.0e38;
+    }
+    return w.z / r;
+}
+
+fn projected_std(cov: vec3<f32>, c: f32, s: f32) -> f32 {
+    return sqrt(max(c * c * cov.x + 2.0 * c * s * cov.z + s * s * cov.y, 0.0));
+}
+
+// smith::lambda [HN12 Eq. 6].
+fn lambda(w: vec3<f32>, cov: vec3<f32>) -> f32 {
+    let mu = cot_theta(w);
+    if (mu >= 3.0e38) {
+        return 0.0;
+    }
+    let r = length(w.xy);
+    let sigma = projected_std(cov, w.x / r, w.y / r);
+    if (!(sigma > 0.0)) {
+        return 0.0;
+    }
+    return smith_lambda(mu / (SQRT_2 * sigma));
+}
+
+fn azimuth_factor(d: f32) -> f32 {
+    let a = min(abs(d), PI);
+    return 4.41 * a / (4.41 * a + 1.0);
+}
+
+fn azimuth_difference(a: vec3<f32>, b: vec3<f32>) -> f32 {
+    let ra = length(a.xy);
+    let rb = length(b.xy);
+    if (!(ra > 0.0 && rb > 0.0)) {
+        return 0.0;
+    }
+    let c = clamp(dot(a.xy, b.xy) / (ra * rb), -1.0, 1.0);
+    let s = (a.x * b.y - a.y * b.x) / (ra * rb);
+    return atan2(abs(s), c);
+}
+
+// MaskingShadowing::from_directions: (Λo, Λi, excess, total).
+fn masking(wo: vec3<f32>, wi: vec3<f32>, cov: vec3<f32>) -> vec4<f32> {
+    let lo = max(lambda(wo, cov), 0.0);
+    let li = max(lambda(wi, cov), 0.0);
+    var excess = li;
+    if (params.correlation == 1u) {
+        let k = azimuth_factor(azimuth_difference(wo, wi));
+        excess = select((li - lo) + k * lo, k * li, lo >= li);
+    }
+    return vec4<f32>(lo, li, excess, lo + excess);
+}
+
+// MaskingShadowing::mean_shadowing [HNPN14 Eq. 12].
+fn mean_shadowing(m: vec4<f32>) -> f32 {
+    return 1.0 / (1.0 + m.z / (1.0 + m.x));
+}
+
+// ---------------------------------------------------------------- attribute.rs
+fn attribute_shape(t: f32) -> f32 {
+    return erf(t * FRAC_1_SQRT_2);
+}
+
+fn mean_attribute_shape(l: f32) -> f32 {
+    return 1.0 - 2.0 / (max(l, 0.0) + 2.0);
+}
+
+// ---------------------------------------------------------------- brdf.rs
+fn slope_of(n: vec3<f32>) -> vec2<f32> {
+    return vec2<f32>(-n.x, -n.y) / max(n.z, 1e-30);
+}
+
+fn normal_of(s: vec2<f32>) -> vec3<f32> {
+    return normalize(vec3<f32>(-s.x, -s.y, 1.0));
+}
+
+fn gaussian2(d: vec2<f32>, c: vec3<f32>) -> f32 {
+    let xx = max(c.x, 1e-14);
+    let yy = max(c.y, 1e-14);
+    let det = max(xx * yy - c.z * c.z, 1e-28);
+    let q = (yy * d.x * d.x - 2.0 * c.z * d.x * d.y + xx * d.y * d.y) / det;
+    return exp(-0.5 * q) / (TAU * sqrt(det));
+}
+
+fn specular_with(n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, extra: vec3<f32>) -> f32 {
+    if (params.specular <= 0.0 || dot(n, wi) <= 0.0 || dot(n, wo) <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0) {
+        return 0.0;
+    }
+    let h = normalize(wo + wi);
+    if (h.z <= 1e-9) {
+        return 0.0;
+    }
+    let s0 = max(params.roughness, 0.0);
+    let d = gaussian2(slope_of(h) - slope_of(n), extra + vec3<f32>(s0 * s0, s0 * s0, 0.0));
+    return params.specular * d / (4.0 * pow(h.z, 4.0) * wo.z);
+}
+
+// BaseBrdf::shade.
+fn shade(color: vec3<f32>, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    let d = params.albedo * FRAC_1_PI * max(dot(n, wi), 0.0);
+    let s = specular_with(n, wo, wi, vec3<f32>(0.0));
+    return color * d + vec3<f32>(s);
+}
+
+// ---------------------------------------------------------------- footprint.rs
+fn cholesky(c: vec3<f32>) -> vec3<f32> {
+    let l11 = sqrt(max(c.x, 0.0));
+    var l21 = 0.0;
+    if (l11 > 0.0) {
+        l21 = c.z / l11;
+    }
+    return vec3<f32>(l11, l21, sqrt(max(c.y - l21 * l21, 0.0)));
+}
+
+// visible_slope_mean with q(n) = (n·ωi)⁺, n×n Gauss–Hermite (nodes/weights at gh_offset).
+fn visible_slope_mean_cos(cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+    let l = cholesky(cov);
+    let n = params.slope_points;
+    var num = 0.0;
+    var den = 0.0;
+    for (var a = 0u; a < n; a = a + 1u) {
+        let xa = data[params.gh_offset + 2u * a];
+        let wa = data[params.gh_offset + 2u * a + 1u];
+        for (var b = 0u; b < n; b = b + 1u) {
+            let xb = data[params.gh_offset + 2u * b];
+            let wb = data[params.gh_offset + 2u * b + 1u];
+            let s = vec2<f32>(l.x * xa, l.y * xa + l.z * xb);
+            let u = max(wo.z - s.x * wo.x - s.y * wo.y, 0.0);
+            let wt = wa * wb * u;
+            if (wt > 0.0) {
+                num = num + wt * max(dot(normal_of(s), wi), 0.0);
+                den = den + wt;
+            }
+        }
+    }
+    if (den > 0.0) {
+        return num / den;
+    }
+    return 0.0;
+}
+
+fn filtered_specular(cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+    if (params.specular <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0) {
+        return 0.0;
+    }
+    let h = normalize(wo + wi);
+    if (h.z <= 1e-9) {
+        return 0.0;
+    }
+    let sh = slope_of(h);
+    let u_h = max(wo.z - sh.x * wo.x - sh.y * wo.y, 0.0);
+    let v = wo.x * wo.x * cov.x + 2.0 * wo.x * wo.y * cov.z + wo.y * wo.y * cov.y;
+    var eu = wo.z;
+    if (v > 1e-30) {
+        let sv = sqrt(v);
+        let r = min(wo.z / sv, 40.0);
+        eu = wo.z * norm_cdf(r) + sv * norm_pdf(r);
+    }
+    let s0 = max(params.roughness, 0.0);
+    let d = gaussian2(sh, cov + vec3<f32>(s0 * s0, s0 * s0, 0.0));
+    return params.specular * d * u_h / (4.0 * pow(h.z, 4.0) * wo.z * max(eu, 1e-30));
+}
+
+// Prepared::point_input: (colour-map input, standardized height) at driver value f.
+fn point_input(f: f32) -> vec2<f32> {
+    let t = (transfer_eval(f).x - params.g_mean) / params.g_std;
+    if (params.color_kind == 0u) {
+        return vec2<f32>(f, t);
+    }
+    return vec2<f32>(t, t);
+}
+
+// Prepared::color_at.
+fn color_at(f: f32) -> vec3<f32> {
+    let it = point_input(f);
+    if (params.color_kind == 2u) {
+        let s = attribute_shape(it.y);
+        return max(params.attr_mean + params.attr_corr * s, vec3<f32>(0.0));
+    }
+    let k = params.cp_knots;
+    return vec3<f32>(poly_eval(params.cp_offset, k, 3u, 0u, it.x), poly_eval(params.cp_offset, k, 3u, 1u, it.x), poly_eval(params.cp_offset, k, 3u, 2u, it.x));
+}
+
+// Prepared::color_of_distribution.
+fn color_of_distribution(mean: f32, sd: f32, l: f32, far: vec2<f32>, w: f32) -> vec3<f32> {
+    if (params.color_kind == 2u) {
+        let g = erf(mean / sqrt(2.0 * (1.0 + sd * sd)));
+        let gf = erf(far.x / sqrt(2.0 * (1.0 + far.y * far.y)));
+        let s = g + clamp(w, 0.0, 1.0) * (mean_attribute_shape(l) - gf);
+        return max(params.attr_mean + params.attr_corr * s, vec3<f32>(0.0));
+    }
+    return table_sample(params.ct_offset, params.ct_size_m, params.ct_size_s, params.ct_m_min, params.ct_m_max, params.ct_sigma_max, mean, sd).xyz;
+}
+
+struct Local {
+    driver: FilteredDriver,
+    transfer: vec4<f32>,
+    stats: SurfaceStats,
+}
+
+fn local_stats(x0: vec2<f32>, fp: vec3<f32>) -> Local {
+    var loc: Local;
+    loc.driver = filtered_driver(x0, fp);
+    loc.transfer = transfer_moments(loc.driver.mean, loc.driver.std_dev);
+    loc.stats = transformed_statistics(loc.transfer, params.sigma_h, loc.driver.mean_gradient, loc.driver.gradient_cov);
+    return loc;
+}
+
+// Prepared::input_distribution.
+fn input_distribution(loc: Local) -> vec2<f32> {
+    if (params.color_kind == 0u) {
+        return vec2<f32>(loc.driver.mean, loc.driver.std_dev);
+    }
+    return vec2<f32>((loc.transfer.x - params.g_mean) / params.g_std, loc.transfer.y / params.g_std);
+}
+
+fn lit(wi: vec3<f32>, n: vec3<f32>) -> f32 {
+    return select(0.0, 1.0, wi.z > 0.0 && dot(n, wi) > 0.0);
+}
+
+// Prepared::naive.
+fn eval_naive(x0: vec2<f32>, fp: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    let loc = local_stats(x0, fp);
+    let n = normal_of(loc.stats.slope_mean);
+    return shade(color_at(loc.driver.mean), n, wo, wi) * lit(wi, n);
+}
+
+// Prepared::view_independent.
+fn eval_view_independent(x0: vec2<f32>, fp: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    let loc = local_stats(x0, fp);
+    let ms = input_distribution(loc);
+    let c = color_of_distribution(ms.x, ms.y, 0.0, vec2<f32>(0.0, 1.0), ms.y * ms.y);
+    let n = normal_of(loc.stats.slope_mean);
+    return shade(c, n, wo, wi) * lit(wi, n);
+}
+
+// footprint::basis (Duff et al. 2017).
+fn basis_t(n: vec3<f32>) -> vec3<f32> {
+    let sign = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    return vec3<f32>(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+}
+
+fn basis_b(n: vec3<f32>) -> vec3<f32> {
+    let sign = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    return vec3<f32>(b, sign + n.y * n.y * a, -n.y);
+}
+
+// Prepared::filtered.
+fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>) -> vec3<f32> {
+    let loc = local_stats(x0, fp);
+    let nbar = normal_of(loc.stats.slope_mean);
+    let t = basis_t(nbar);
+    let b = basis_b(nbar);
+    let wo = vec3<f32>(dot(wo_w, t), dot(wo_w, b), dot(wo_w, nbar));
+    let wi = vec3<f32>(dot(wi_w, t), dot(wi_w, b), dot(wi_w, nbar));
+    if (wo.z <= 0.0 || wo_w.z <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let cov = loc.stats.slope_cov;
+    let ms = masking(wo, wi, cov);
+    let hm = height_moments(ms.w);
+    let d = input_distribution(loc);
+    let color = color_of_distribution(d.x + d.y * hm.x, d.y * hm.y, ms.w, hm, d.y * d.y);
+    var vbar = 0.0;
+    if (wi.z > 0.0 && wi_w.z > 0.0) {
+        vbar = mean_shadowing(ms);
+    }
+    let diffuse = params.albedo * FRAC_1_PI * visible_slope_mean_cos(cov, wo, wi);
+    let spec = filtered_specular(cov, wo, wi);
+    return vbar * (color * diffuse + vec3<f32>(spec));
+}
+
+// ---------------------------------------------------------------- surface.rs (ground truth)
+fn surface_height(x: vec2<f32>) -> f32 {
+    return params.sigma_h * transfer_eval(value_and_gradient(x).x).x;
+}
+
+fn lipschitz_along(dir: vec2<f32>) -> f32 {
+    var s = 0.0;
+    for (var i = 0u; i < params.wave_count; i = i + 1u) {
+        let w = wave(i);
+        s = s + abs(w.z) * TAU * abs(dot(w.xy, dir));
+    }
+    return params.sigma_h * params.g_lip * s;
+}
+
+// Surface::march: t of the first crossing, or -1 when the ray escapes. o on or above the surface.
+fn march(o: vec3<f32>, d: vec3<f32>) -> f32 {
+    let r = length(d.xy);
+    var k = 0.0;
+    if (r > 0.0) {
+        k = lipschitz_along(d.xy / r);
+    }
+    let rate = abs(d.z) + k * r;
+    if (rate <= 0.0) {
+        return -1.0;
+    }
+    let top = params.h_max * (1.0 + 1e-6) + 1e-30;
+    var t = 0.0;
+    var prev = 0.0;
+    for (var it = 0u; it < 20000u; it = it + 1u) {
+        let p = o + d * t;
+        if ((d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0)) {
+            return -1.0;
+        }
+        var gap = p.z - surface_height(p.xy);
+        if (gap < 0.0 && t == 0.0) {
+            // The origin is on the surface by contract: a negative gap here is rounding.
+            gap = 0.0;
+        }
+        if (gap < 0.0) {
+            var a = prev;
+            var b = t;
+            for (var j = 0u; j < 24u; j = j + 1u) {
+                let m = 0.5 * (a + b);
+                let q = o + d * m;
+                if (q.z - surface_height(q.xy) >= 0.0) {
+                    a = m;
+                } else {
+                    b = m;
+                }
+            }
+            return a;
+        }
+        prev = t;
+        t = t + max(gap / rate, params.min_step);
+    }
+    return -1.0;
+}
+
+fn sees(p: vec3<f32>, d: vec3<f32>) -> bool {
+    if (d.z <= 0.0) {
+        return false;
+    }
+    return march(p, d) < 0.0;
+}
+
+// Prepared::trace_pixel_sample for a camera ray (origin, unit direction).
+fn trace_ray(origin: vec3<f32>, dir: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    if (dir.z >= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    // Start on the top of the slab.
+    let top = params.h_max * 1.001 + 1e-6;
+    let t0 = max((origin.z - top) / -dir.z, 0.0);
+    let o = origin + dir * t0;
+    let t = march(o, dir);
+    if (t < 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let p = o + dir * t;
+    let fg = value_and_gradient(p.xy);
+    let gd = transfer_eval(fg.x);
+    let n = normal_of(fg.yz * (params.sigma_h * gd.y));
+    if (dot(n, wi) <= 0.0 || wi.z <= 0.0 || !sees(p, wi)) {
+        return vec3<f32>(0.0);
+    }
+    return shade(color_at(fg.x), n, -dir, wi);
+}

@@ -1,0 +1,92 @@
+// One view of the plane scene: a compute pass over the image. Needs special.wgsl and material.wgsl.
+// Modes: 0 naive MIP, 1 view-independent filtering, 2 filtered, 3 ground truth (progressive: one
+// stratified, jittered, Gaussian-filtered sub-pixel ray per pixel per frame; alpha counts samples).
+
+@group(0) @binding(2) var<storage, read_write> accum: array<vec4<f32>>;
+
+const PIXEL_SIGMA_DEFAULT: f32 = 0.5;
+
+// Camera::raw_dir (unnormalised), pixel coordinates with centres at +0.5.
+fn raw_dir(p: vec2<f32>) -> vec3<f32> {
+    let nx = (p.x / f32(params.width)) * 2.0 - 1.0;
+    let ny = 1.0 - (p.y / f32(params.height)) * 2.0;
+    return params.forward + params.right * (nx * params.tan_half_fov * params.aspect) + params.up * (ny * params.tan_half_fov);
+}
+
+// Camera::plane_footprint: (x0.x, x0.y) and covariance (xx, yy, xy); w = 0 marks the sky.
+struct PlaneFootprint {
+    x0: vec2<f32>,
+    cov: vec3<f32>,
+    hit: bool,
+}
+
+fn plane_footprint(p: vec2<f32>) -> PlaneFootprint {
+    var r: PlaneFootprint;
+    let e = params.eye;
+    let d = raw_dir(p);
+    r.hit = d.z < 0.0;
+    if (!r.hit) {
+        return r;
+    }
+    let dx = params.right * (2.0 * params.tan_half_fov * params.aspect / f32(params.width));
+    let dy = params.up * (-2.0 * params.tan_half_fov / f32(params.height));
+    let hit = e - d * (e.z / d.z);
+    let jx = -(dx * d.z - d * dx.z) * (e.z / (d.z * d.z));
+    let jy = -(dy * d.z - d * dy.z) * (e.z / (d.z * d.z));
+    let s2 = params.pixel_sigma * params.pixel_sigma;
+    r.x0 = hit.xy;
+    r.cov = vec3<f32>(jx.x * jx.x + jy.x * jy.x, jx.y * jx.y + jy.y * jy.y, jx.x * jx.y + jy.x * jy.y) * s2;
+    return r;
+}
+
+// PCG hash → uniform in [0, 1).
+fn pcg(v: u32) -> u32 {
+    let state = v * 747796405u + 2891336453u;
+    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+    return (word >> 22u) ^ word;
+}
+
+fn uniform01(seed: u32) -> f32 {
+    return f32(pcg(seed) >> 8u) * (1.0 / 16777216.0);
+}
+
+@compute @workgroup_size(8, 8)
+fn view_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= params.width || gid.y >= params.height) {
+        return;
+    }
+    let idx = gid.y * params.width + gid.x;
+    let centre = vec2<f32>(f32(gid.x) + 0.5, f32(gid.y) + 0.5);
+    let wi = params.light;
+    if (params.mode < 3u) {
+        let fp = plane_footprint(centre);
+        var c = vec3<f32>(0.0);
+        if (fp.hit) {
+            let wo = -normalize(raw_dir(centre));
+            if (params.mode == 0u) {
+                c = eval_naive(fp.x0, fp.cov, wo, wi);
+            } else if (params.mode == 1u) {
+                c = eval_view_independent(fp.x0, fp.cov, wo, wi);
+            } else {
+                c = eval_filtered(fp.x0, fp.cov, wo, wi);
+            }
+        }
+        accum[idx] = vec4<f32>(c, 1.0);
+        return;
+    }
+    // Ground truth, one sample per frame: frame s takes stratum (s mod n, ⌊s/n⌋ mod n) of an n×n grid
+    // (n = spp_side) over the Gaussian pixel filter (Box–Muller on the stratum), jittered by a hash.
+    let n = max(params.spp_side, 1u);
+    let s = params.frame;
+    let a = s % n;
+    let b = (s / n) % n;
+    let seed = (idx * 9781u + s * 6271u + 1u) * 2654435761u;
+    let u1 = (f32(a) + uniform01(seed)) / f32(n);
+    let u2 = (f32(b) + uniform01(seed ^ 0x9e3779b9u)) / f32(n);
+    let rad = sqrt(-2.0 * log(max(u1, 1e-7))) * params.pixel_sigma;
+    let off = vec2<f32>(rad * cos(TAU * u2), rad * sin(TAU * u2));
+    let d = normalize(raw_dir(centre + off));
+    let c = trace_ray(params.eye, d, wi);
+    let prev = select(vec4<f32>(0.0), accum[idx], s > 0u);
+    accum[idx] = prev + vec4<f32>(c, 1.0);
+}

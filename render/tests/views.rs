@@ -1,0 +1,221 @@
+//! The GPU views against lodestone-core: every pixel of naive, view-independent and filtered images
+//! equals core's CPU evaluation of that pixel's footprint (f32 against f64), over several materials
+//! and cameras (near, grazing, far); the GPU ground truth agrees with core's CPU ray tracer.
+
+use glam::{DVec2, DVec3};
+use lodestone_core::camera::Camera;
+use lodestone_core::footprint::{Config, Prepared};
+use lodestone_core::material::Material;
+use lodestone_core::noise::Footprint;
+use lodestone_core::smith::direction;
+use lodestone_render::{GpuContext, GpuMaterial, Renderer, Scene, ViewMode};
+
+fn preset(name: &str) -> Material {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../presets")
+        .join(name);
+    Material::from_ron(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn renderer() -> Option<Renderer> {
+    match GpuContext::new_headless() {
+        Ok(ctx) => Some(Renderer::new(ctx)),
+        Err(e) => {
+            eprintln!("skipping GPU view test: {e}");
+            None
+        }
+    }
+}
+
+fn cpu_pixel(
+    p: &Prepared,
+    scene: &Scene,
+    mode: ViewMode,
+    x: u32,
+    y: u32,
+    w: u32,
+    h: u32,
+) -> [f64; 3] {
+    let c = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+    let Some((x0, cov)) = scene.camera.plane_footprint(c, w, h) else {
+        return [0.0; 3];
+    };
+    let wo = -scene.camera.ray(c, w, h).dir;
+    let cfg = Config {
+        wo,
+        wi: scene.light,
+        x0,
+        footprint: Footprint { cov },
+    };
+    match mode {
+        ViewMode::Naive => p.naive(&cfg),
+        ViewMode::ViewIndependent => p.view_independent(&cfg),
+        ViewMode::Filtered => p.filtered(&cfg),
+        ViewMode::Truth => unreachable!(),
+    }
+}
+
+#[test]
+fn analytic_views_match_core_pixel_by_pixel() {
+    let Some(r) = renderer() else { return };
+    let cameras = [
+        (
+            "near",
+            Camera {
+                elevation_deg: 35.0,
+                azimuth_deg: 20.0,
+                distance: 0.6,
+                target: [1.3, -2.1],
+                fov_deg: 40.0,
+            },
+        ),
+        (
+            "grazing",
+            Camera {
+                elevation_deg: 82.0,
+                azimuth_deg: -40.0,
+                distance: 3.0,
+                target: [40.0, 17.0],
+                fov_deg: 30.0,
+            },
+        ),
+        (
+            "far",
+            Camera {
+                elevation_deg: 60.0,
+                azimuth_deg: 110.0,
+                distance: 400.0,
+                target: [-250.0, 90.0],
+                fov_deg: 25.0,
+            },
+        ),
+    ];
+    let light = direction(0.7, 2.2);
+    let (w, h) = (40, 28);
+    let mut compared = 0;
+    for name in [
+        "default.ron",
+        "moss.ron",
+        "dirt-in-crevices.ron",
+        "grooves.ron",
+    ] {
+        let m = preset(name);
+        let p = Prepared::new(&m).unwrap();
+        for (cam_name, camera) in cameras {
+            let scene = Scene { camera, light };
+            let gm = GpuMaterial::new(r.context(), &p, camera.target);
+            for mode in [
+                ViewMode::Naive,
+                ViewMode::ViewIndependent,
+                ViewMode::Filtered,
+            ] {
+                let img = r.render(&gm, &scene, mode, (w, h), 1);
+                let mut worst = (0.0f64, 0, 0);
+                for y in 0..h {
+                    for x in 0..w {
+                        let want = cpu_pixel(&p, &scene, mode, x, y, w, h);
+                        let got = img.rgb(x, y);
+                        for k in 0..3 {
+                            let err = (f64::from(got[k]) - want[k]).abs();
+                            let tol = 5e-3 * want[k].abs() + 2e-4;
+                            if err / tol > worst.0 {
+                                worst = (err / tol, x, y);
+                            }
+                            compared += 1;
+                        }
+                    }
+                }
+                let (wx, wy) = (worst.1, worst.2);
+                assert!(
+                    worst.0 <= 1.0,
+                    "{name} {cam_name} {mode:?}: pixel ({wx}, {wy}) GPU {:?} vs core {:?}",
+                    img.rgb(wx, wy),
+                    cpu_pixel(&p, &scene, mode, wx, wy, w, h)
+                );
+            }
+        }
+    }
+    assert!(compared >= 10_000);
+}
+
+#[test]
+fn ground_truth_matches_the_cpu_ray_tracer_on_a_far_patch() {
+    let Some(r) = renderer() else { return };
+    let m = preset("default.ron");
+    let p = Prepared::new(&m).unwrap();
+    for elevation in [0.0_f64, 60.0] {
+        // A distant, narrow camera: every pixel covers many features, so the image mean estimates the
+        // same stationary expectation as the CPU's far patch.
+        let camera = Camera {
+            elevation_deg: elevation,
+            azimuth_deg: 0.0,
+            distance: 2000.0,
+            target: [5.0, 3.0],
+            fov_deg: 2.0,
+        };
+        let scene = Scene {
+            camera,
+            light: DVec3::Z,
+        };
+        let gm = GpuMaterial::new(r.context(), &p, camera.target);
+        let img = r.render(&gm, &scene, ViewMode::Truth, (16, 16), 64);
+        let mut mean = [0.0f64; 3];
+        for y in 0..16 {
+            for x in 0..16 {
+                let c = img.rgb(x, y);
+                for k in 0..3 {
+                    mean[k] += f64::from(c[k]) / 256.0;
+                }
+            }
+        }
+        let cpu = p.ground_truth(
+            &Config::far(&p, direction(elevation.to_radians(), 0.0), DVec3::Z),
+            60_000,
+            9,
+        );
+        for k in 0..3 {
+            let rel = (mean[k] - cpu.mean[k]).abs() / cpu.mean[k];
+            assert!(
+                rel < 0.02,
+                "elevation {elevation}°, channel {k}: GPU truth {} vs CPU truth {} ± {}",
+                mean[k],
+                cpu.mean[k],
+                cpu.std_error[k]
+            );
+        }
+        eprintln!(
+            "elevation {elevation}°: GPU truth {mean:.4?}, CPU truth {:.4?} ± {:.4?}",
+            cpu.mean, cpu.std_error
+        );
+    }
+}
+
+#[test]
+#[ignore = "debugging aid"]
+fn debug_truth_pixels() {
+    let Some(r) = renderer() else { return };
+    let p = Prepared::new(&preset("default.ron")).unwrap();
+    let camera = Camera {
+        elevation_deg: 60.0,
+        azimuth_deg: 0.0,
+        distance: 2000.0,
+        target: [5.0, 3.0],
+        fov_deg: 2.0,
+    };
+    let scene = Scene {
+        camera,
+        light: DVec3::Z,
+    };
+    let gm = GpuMaterial::new(r.context(), &p, camera.target);
+    let img = r.render(&gm, &scene, ViewMode::Truth, (8, 4), 1);
+    for y in 0..4 {
+        let row: Vec<String> = (0..8).map(|x| format!("{:.3}", img.rgb(x, y)[0])).collect();
+        let cpu: Vec<String> = (0..8)
+            .map(|x| {
+                let ray = camera.ray(DVec2::new(x as f64 + 0.5, y as f64 + 0.5), 8, 4);
+                format!("{:.3}", p.trace_ray(ray.origin, ray.dir, DVec3::Z)[0])
+            })
+            .collect();
+        eprintln!("gpu {row:?}\ncpu {cpu:?}");
+    }
+}
