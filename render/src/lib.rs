@@ -5,10 +5,11 @@
 //! `lodestone-core`'s f32 functions and the harness that checks them on the adapter.
 
 pub mod compute;
+pub mod error_map;
 pub mod gpu;
 pub mod gpu_types;
 pub mod renderer;
 pub mod shaders;
 
 pub use gpu::{GpuContext, GpuError};
-pub use renderer::{GpuMaterial, LinearImage, Renderer, Scene, ViewMode};
+pub use renderer::{GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget};

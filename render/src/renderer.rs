@@ -107,6 +107,88 @@ pub struct GpuMaterial {
     target: [f64; 2],
 }
 
+/// One view's render target: an accumulation buffer (linear RGB + sample count per pixel) and its
+/// own parameter buffer, so several views can be drawn in one submission without sharing state.
+#[derive(Debug)]
+pub struct ViewTarget {
+    width: u32,
+    height: u32,
+    accum: wgpu::Buffer,
+    params: wgpu::Buffer,
+    /// Ground-truth rays per pixel accumulated so far.
+    pub samples: u32,
+}
+
+impl ViewTarget {
+    /// A target of `width × height` pixels.
+    pub fn new(renderer: &Renderer, width: u32, height: u32) -> Self {
+        let device = &renderer.ctx.device;
+        let (width, height) = (width.max(1), height.max(1));
+        let accum = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("accumulation"),
+            size: u64::from(width) * u64::from(height) * 16,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("params"),
+            size: std::mem::size_of::<GpuParams>() as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Self {
+            width,
+            height,
+            accum,
+            params,
+            samples: 0,
+        }
+    }
+
+    /// Start accumulating afresh (the next ground-truth frame overwrites instead of adding).
+    pub fn reset(&mut self) {
+        self.samples = 0;
+    }
+
+    /// Size in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// Read the target back (waits for the GPU).
+    pub fn read(&self, renderer: &Renderer) -> LinearImage {
+        let device = &renderer.ctx.device;
+        let size = u64::from(self.width) * u64::from(self.height) * 16;
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("readback"),
+        });
+        enc.copy_buffer_to_buffer(&self.accum, 0, &readback, 0, size);
+        renderer.ctx.queue.submit([enc.finish()]);
+        let slice = readback.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |r| r.expect("map readback"));
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("device poll");
+        let view = slice.get_mapped_range().expect("mapped range");
+        let floats: &[f32] = bytemuck::cast_slice(&view);
+        let pixels = floats
+            .chunks_exact(4)
+            .map(|c| [c[0], c[1], c[2], c[3]])
+            .collect();
+        LinearImage {
+            width: self.width,
+            height: self.height,
+            pixels,
+        }
+    }
+}
+
 /// The renderer: one compute pipeline for every mode.
 #[derive(Debug)]
 pub struct Renderer {
@@ -281,8 +363,8 @@ impl Renderer {
         &self.ctx
     }
 
-    /// Render `mode` at `width × height`. Ground truth accumulates `samples` frames of one ray per
-    /// pixel, stratified over a ⌈√samples⌉² grid of the pixel filter; the analytic modes ignore it.
+    /// Render `mode` at `width × height` into a fresh target and read it back. Ground truth takes
+    /// `samples` rays per pixel; the analytic modes ignore it.
     pub fn render(
         &self,
         material: &GpuMaterial,
@@ -291,18 +373,31 @@ impl Renderer {
         (width, height): (u32, u32),
         samples: u32,
     ) -> LinearImage {
-        let samples = samples.max(1);
-        let spp_side = (f64::from(samples).sqrt().ceil() as u32).max(1);
-        let device = &self.ctx.device;
+        let mut target = ViewTarget::new(self, width, height);
+        self.draw(&mut target, material, scene, mode, samples);
+        target.read(self)
+    }
+
+    /// Draw into a persistent target. Analytic modes overwrite it; ground truth adds `samples` more
+    /// rays per pixel to what the target holds (progressive; low-discrepancy, so any count is unbiased). Call [`ViewTarget::reset`] when the camera, light or material
+    /// changes.
+    pub fn draw(
+        &self,
+        target: &mut ViewTarget,
+        material: &GpuMaterial,
+        scene: &Scene,
+        mode: ViewMode,
+        samples: u32,
+    ) {
+        let (width, height) = (target.width, target.height);
         let mut params = material.base;
         let cam = Camera {
             target: [0.0, 0.0],
             ..scene.camera
         };
         let (r, u, f) = cam.basis();
-        let eye = cam.eye();
         let v3 = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32];
-        params.eye = v3(eye);
+        params.eye = v3(cam.eye());
         params.right = v3(r);
         params.up = v3(u);
         params.forward = v3(f);
@@ -314,47 +409,47 @@ impl Renderer {
         params.width = width;
         params.height = height;
         params.mode = mode.code();
-        params.spp_side = spp_side.max(1);
-        let param_buf = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("params"),
-            size: std::mem::size_of::<GpuParams>() as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let size = u64::from(width) * u64::from(height) * 16;
-        let accum = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("accumulation"),
-            size,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-            mapped_at_creation: false,
-        });
-        let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("view"),
-            layout: &self.pipeline.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: param_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: material.data.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: accum.as_entire_binding(),
-                },
-            ],
-        });
-        let frames = if mode == ViewMode::Truth { samples } else { 1 };
-        for frame in 0..frames {
-            params.frame = frame;
+        let bind = self
+            .ctx
+            .device
+            .create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("view"),
+                layout: &self.pipeline.get_bind_group_layout(0),
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: target.params.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: material.data.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: target.accum.as_entire_binding(),
+                    },
+                ],
+            });
+        let frames = if mode == ViewMode::Truth {
+            samples.max(1)
+        } else {
+            1
+        };
+        for _ in 0..frames {
+            params.frame = if mode == ViewMode::Truth {
+                target.samples
+            } else {
+                0
+            };
             self.ctx
                 .queue
-                .write_buffer(&param_buf, 0, bytemuck::bytes_of(&params));
-            let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("view"),
-            });
+                .write_buffer(&target.params, 0, bytemuck::bytes_of(&params));
+            let mut enc = self
+                .ctx
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                    label: Some("view"),
+                });
             {
                 let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("view"),
@@ -365,33 +460,12 @@ impl Renderer {
                 pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
             }
             self.ctx.queue.submit([enc.finish()]);
+            target.samples += u32::from(mode == ViewMode::Truth);
         }
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("readback"),
-        });
-        enc.copy_buffer_to_buffer(&accum, 0, &readback, 0, size);
-        self.ctx.queue.submit([enc.finish()]);
-        let slice = readback.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |r| r.expect("map readback"));
-        device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .expect("device poll");
-        let view = slice.get_mapped_range().expect("mapped range");
-        let floats: &[f32] = bytemuck::cast_slice(&view);
-        let pixels = floats
-            .chunks_exact(4)
-            .map(|c| [c[0], c[1], c[2], c[3]])
-            .collect();
-        LinearImage {
-            width,
-            height,
-            pixels,
-        }
+    }
+
+    /// Block until the GPU has finished all submitted work (for timing).
+    pub fn wait(&self) {
+        let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
     }
 }

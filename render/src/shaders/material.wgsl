@@ -27,7 +27,7 @@ struct Params {
     dh_ln_max: f32,
     width: u32,
     height: u32,
-    spp_side: u32,
+    reserved: u32,
     wave_count: u32,
     sigma_h: f32,
     albedo: f32,

@@ -1,6 +1,6 @@
 // One view of the plane scene: a compute pass over the image. Needs special.wgsl and material.wgsl.
 // Modes: 0 naive MIP, 1 view-independent filtering, 2 filtered, 3 ground truth (progressive: one
-// stratified, jittered, Gaussian-filtered sub-pixel ray per pixel per frame; alpha counts samples).
+// low-discrepancy, Gaussian-filtered sub-pixel ray per pixel per frame; alpha counts samples).
 
 @group(0) @binding(2) var<storage, read_write> accum: array<vec4<f32>>;
 
@@ -39,16 +39,13 @@ fn plane_footprint(p: vec2<f32>) -> PlaneFootprint {
     return r;
 }
 
-// PCG hash → uniform in [0, 1).
+// PCG hash (Jarzynski and Olano 2020).
 fn pcg(v: u32) -> u32 {
     let state = v * 747796405u + 2891336453u;
     let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
     return (word >> 22u) ^ word;
 }
 
-fn uniform01(seed: u32) -> f32 {
-    return f32(pcg(seed) >> 8u) * (1.0 / 16777216.0);
-}
 
 @compute @workgroup_size(8, 8)
 fn view_main(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -74,16 +71,16 @@ fn view_main(@builtin(global_invocation_id) gid: vec3<u32>) {
         accum[idx] = vec4<f32>(c, 1.0);
         return;
     }
-    // Ground truth, one sample per frame: frame s takes stratum (s mod n, ⌊s/n⌋ mod n) of an n×n grid
-    // (n = spp_side) over the Gaussian pixel filter (Box–Muller on the stratum), jittered by a hash.
-    let n = max(params.spp_side, 1u);
+    // Ground truth, one sample per frame: sample s of the R2 low-discrepancy sequence (fixed-point
+    // golden-ratio generalisation), Cranley–Patterson rotated per pixel, mapped through Box–Muller
+    // onto the Gaussian pixel filter. Every prefix of the sequence is evenly spread, so progressive
+    // images are unbiased at any sample count.
     let s = params.frame;
-    let a = s % n;
-    let b = (s / n) % n;
-    let seed = (idx * 9781u + s * 6271u + 1u) * 2654435761u;
-    let u1 = (f32(a) + uniform01(seed)) / f32(n);
-    let u2 = (f32(b) + uniform01(seed ^ 0x9e3779b9u)) / f32(n);
-    let rad = sqrt(-2.0 * log(max(u1, 1e-7))) * params.pixel_sigma;
+    let r1 = s * 3242174889u + pcg(idx * 2u + 1u);
+    let r2 = s * 2447445413u + pcg(idx * 2u + 2u);
+    let u1 = (f32(r1 >> 8u) + 0.5) * (1.0 / 16777216.0);
+    let u2 = (f32(r2 >> 8u) + 0.5) * (1.0 / 16777216.0);
+    let rad = sqrt(-2.0 * log(u1)) * params.pixel_sigma;
     let off = vec2<f32>(rad * cos(TAU * u2), rad * sin(TAU * u2));
     let d = normalize(raw_dir(centre + off));
     let c = trace_ray(params.eye, d, wi);
