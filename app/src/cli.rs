@@ -41,10 +41,89 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Render the plane scene under one mode (or all of them) to PNG (8-bit sRGB) or EXR (linear).
+    Render {
+        /// naive, view-independent, filtered, truth, error (filtered against truth) or all.
+        #[arg(long, value_enum, default_value_t = RenderMode::All)]
+        mode: RenderMode,
+        /// Camera angle from the normal, degrees (0 to 89.5).
+        #[arg(long, default_value_t = 60.0)]
+        view_deg: f64,
+        /// Camera azimuth, degrees.
+        #[arg(long, default_value_t = 0.0)]
+        view_azimuth_deg: f64,
+        /// Light angle from the normal, degrees.
+        #[arg(long, default_value_t = 30.0)]
+        light_deg: f64,
+        /// Light azimuth, degrees.
+        #[arg(long, default_value_t = 90.0)]
+        light_azimuth_deg: f64,
+        /// Camera distance to its target (world units); features are about 1 unit across.
+        #[arg(long, default_value_t = 6.0)]
+        distance: f64,
+        /// Image size, WxH.
+        #[arg(long, default_value = "512x384", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Ground-truth rays per pixel.
+        #[arg(long, default_value_t = 64)]
+        spp: u32,
+        /// Output: a .png or .exr file, or a directory for `--mode all`.
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Time each mode's frame on the GPU adapter (medians of repeated frames) and the
+    /// filtered/naive cost ratio.
+    Bench {
+        /// Image size, WxH.
+        #[arg(long, default_value = "512x512", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Timed frames per mode (after one warm-up frame).
+        #[arg(long, default_value_t = 5)]
+        frames: u32,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Parse and validate a preset; exit code 2 and every problem on failure.
     Validate,
     /// Print the preset (the built-in default when --preset is omitted) as RON.
     Show,
     /// Describe the GPU adapter wgpu finds; exit code 3 when there is none.
     Adapter,
+}
+
+/// What `render` draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum RenderMode {
+    /// Naive MIP.
+    Naive,
+    /// View-independent texture filtering.
+    ViewIndependent,
+    /// The filtered model.
+    Filtered,
+    /// Ray-traced ground truth.
+    Truth,
+    /// Heat map of |filtered − truth|.
+    Error,
+    /// Every mode and every error map, into a directory.
+    All,
+}
+
+/// Parse "WxH".
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WxH, got {s:?}"))?;
+    let w: u32 = w
+        .trim()
+        .parse()
+        .map_err(|_| format!("bad width in {s:?}"))?;
+    let h: u32 = h
+        .trim()
+        .parse()
+        .map_err(|_| format!("bad height in {s:?}"))?;
+    if w == 0 || h == 0 || w > 8192 || h > 8192 {
+        return Err(format!("size must be between 1x1 and 8192x8192, got {s:?}"));
+    }
+    Ok((w, h))
 }

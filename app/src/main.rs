@@ -5,6 +5,7 @@
 
 mod cli;
 mod eval;
+mod render_cmd;
 
 use anyhow::{Context, Result};
 use clap::Parser;
@@ -97,6 +98,29 @@ fn run(cli: Cli) -> Result<()> {
             } else {
                 print!("{}", eval::table(&r));
             }
+        }
+        Some(Command::Render {
+            mode,
+            view_deg,
+            view_azimuth_deg,
+            light_deg,
+            light_azimuth_deg,
+            distance,
+            size,
+            spp,
+            out,
+        }) => {
+            let view = render_cmd::View {
+                view_deg,
+                view_azimuth_deg,
+                light_deg,
+                light_azimuth_deg,
+                distance,
+            };
+            render_cmd::render(&material, view, mode, size, spp, &out)?;
+        }
+        Some(Command::Bench { size, frames, json }) => {
+            render_cmd::bench(&material, size, frames, json)?
         }
         Some(Command::Validate) => println!("ok: {} is a valid preset", material.name),
         Some(Command::Show) => println!("{}", material.to_ron()),
