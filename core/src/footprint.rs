@@ -370,6 +370,131 @@ impl Prepared {
     }
 }
 
+/// The statistical methods, for [`Prepared::pixel`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Method {
+    /// [`Prepared::naive`].
+    Naive,
+    /// [`Prepared::view_independent`].
+    ViewIndependent,
+    /// [`Prepared::filtered`].
+    Filtered,
+}
+
+/// The level-of-detail surface a pixel sees: the heightfield at the pixel footprint's scale,
+/// `h̄(x) = σ_h·ḡ(f̄(x), σ_f)` ("tessellated surfaces are displaced according to ḡ" [HNPN14 Sec. 7]).
+/// Close up it is the explicit relief; far away every component is attenuated and it flattens to the
+/// mean plane, continuously, so the views show relief, parallax and real (resolved) shadows up close
+/// and pure statistics at distance, with nothing switching in between.
+impl Prepared {
+    /// h̄(x) for footprint `fp` (σ_f is phase-averaged, hence constant over x).
+    pub fn lod_height(&self, x: DVec2, fp: Footprint) -> f64 {
+        let d = self.surface.noise.filtered(x, fp);
+        self.surface.sigma_h * self.transfer_moments(d.mean, d.std).mean
+    }
+
+    /// Rate bound of the gap along d: `|d_z| + K|d_xy|`, with K = σ_h·max|g′|·Σ|a_i| g_i 2π|k_i·d̂|
+    /// (the attenuated components bound the slope of f̄; ∂ḡ/∂m = E[g′] ≤ max|g′|).
+    fn lod_rate(&self, d: DVec3, fp: Footprint) -> f64 {
+        let dxy = DVec2::new(d.x, d.y);
+        let r = dxy.length();
+        let mut k = 0.0;
+        if r > 0.0 {
+            let dir = dxy / r;
+            let n = &self.surface.noise;
+            k = n
+                .waves
+                .iter()
+                .map(|w| {
+                    w.amplitude.abs()
+                        * n.attenuation(w, fp)
+                        * std::f64::consts::TAU
+                        * w.k.dot(dir).abs()
+                })
+                .sum::<f64>()
+                * self.surface.sigma_h
+                * self.surface.g_lip;
+        }
+        d.z.abs() + k * r
+    }
+
+    /// March `o + t·d` against h̄ (same rule as [`Surface::march`]): the first crossing, if any.
+    pub fn lod_march(&self, o: DVec3, d: DVec3, fp: Footprint) -> Option<f64> {
+        let rate = self.lod_rate(d, fp);
+        if rate <= 0.0 {
+            return None;
+        }
+        let top = self.surface.h_max * (1.0 + 1e-12) + 1e-300;
+        let gap = |t: f64| {
+            let p = o + d * t;
+            p.z - self.lod_height(DVec2::new(p.x, p.y), fp)
+        };
+        let (mut t, mut prev) = (0.0, 0.0);
+        for _ in 0..100_000 {
+            let p = o + d * t;
+            if (d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0) {
+                return None;
+            }
+            let mut g = gap(t);
+            if g < 0.0 && t == 0.0 {
+                g = 0.0; // the origin is on the surface: rounding
+            }
+            if g < 0.0 {
+                let (mut a, mut b) = (prev, t);
+                for _ in 0..48 {
+                    let m = 0.5 * (a + b);
+                    if gap(m) >= 0.0 {
+                        a = m;
+                    } else {
+                        b = m;
+                    }
+                }
+                return Some(a);
+            }
+            prev = t;
+            t += (g / rate).max(self.surface.min_step);
+        }
+        None
+    }
+
+    /// One pixel of an analytic view: the camera ray (origin, unit dir) meets the level-of-detail
+    /// surface; the method is evaluated there with the pixel's footprint `fp`, and the result is 0 where
+    /// the resolved geometry shadows the light (a real shadow ray on h̄).
+    pub fn pixel(
+        &self,
+        method: Method,
+        origin: DVec3,
+        dir: DVec3,
+        wi: DVec3,
+        fp: Footprint,
+    ) -> [f64; 3] {
+        if dir.z >= 0.0 {
+            return [0.0; 3];
+        }
+        let top = self.surface.h_max * 1.001 + 1e-6;
+        let t0 = ((origin.z - top) / -dir.z).max(0.0);
+        let o = origin + dir * t0;
+        let Some(t) = self.lod_march(o, dir, fp) else {
+            return [0.0; 3];
+        };
+        let p = o + dir * t;
+        if wi.z <= 0.0 || self.lod_march(p, wi, fp).is_some() {
+            return [0.0; 3];
+        }
+        let cfg = Config {
+            wo: -dir,
+            wi,
+            x0: DVec2::new(p.x, p.y),
+            footprint: fp,
+        };
+        match method {
+            Method::Naive => self.naive(&cfg),
+            Method::ViewIndependent => self.view_independent(&cfg),
+            Method::Filtered => self.filtered(&cfg),
+        }
+    }
+}
+
 impl Config {
     /// A far, fully filtered footprint for `prepared`: isotropic with a standard deviation of 20 times
     /// the longest wavelength of the driver, centred away from the origin.

@@ -59,14 +59,7 @@ fn view_main(@builtin(global_invocation_id) gid: vec3<u32>) {
         let fp = plane_footprint(centre);
         var c = vec3<f32>(0.0);
         if (fp.hit) {
-            let wo = -normalize(raw_dir(centre));
-            if (params.mode == 0u) {
-                c = eval_naive(fp.x0, fp.cov, wo, wi);
-            } else if (params.mode == 1u) {
-                c = eval_view_independent(fp.x0, fp.cov, wo, wi);
-            } else {
-                c = eval_filtered(fp.x0, fp.cov, wo, wi);
-            }
+            c = analytic_pixel(params.mode, params.eye, normalize(raw_dir(centre)), wi, fp.cov);
         }
         accum[idx] = vec4<f32>(c, 1.0);
         return;
