@@ -70,6 +70,9 @@ pub enum Command {
         /// Output: a .png or .exr file, or a directory for `--mode all`.
         #[arg(long)]
         out: PathBuf,
+        /// Formats written by `--mode all`.
+        #[arg(long, value_enum, default_value_t = Formats::Both)]
+        formats: Formats,
     },
     /// Time each mode's frame on the GPU adapter (medians of repeated frames) and the
     /// filtered/naive cost ratio.
@@ -126,4 +129,15 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
         return Err(format!("size must be between 1x1 and 8192x8192, got {s:?}"));
     }
     Ok((w, h))
+}
+
+/// Image formats `render --mode all` writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Formats {
+    /// 8-bit sRGB PNG only.
+    Png,
+    /// Linear EXR only (error maps stay PNG).
+    Exr,
+    /// Both.
+    Both,
 }

@@ -109,6 +109,7 @@ fn run(cli: Cli) -> Result<()> {
             size,
             spp,
             out,
+            formats,
         }) => {
             let view = render_cmd::View {
                 view_deg,
@@ -117,7 +118,7 @@ fn run(cli: Cli) -> Result<()> {
                 light_azimuth_deg,
                 distance,
             };
-            render_cmd::render(&material, view, mode, size, spp, &out)?;
+            render_cmd::render(&material, view, mode, size, spp, &out, formats)?;
         }
         Some(Command::Bench { size, frames, json }) => {
             render_cmd::bench(&material, size, frames, json)?

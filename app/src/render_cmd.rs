@@ -1,6 +1,6 @@
 //! `lodestone render` and `lodestone bench`: headless GPU work.
 
-use crate::cli::RenderMode;
+use crate::cli::{Formats, RenderMode};
 use anyhow::{Context, Result, bail};
 use lodestone_core::camera::Camera;
 use lodestone_core::footprint::Prepared;
@@ -59,6 +59,16 @@ fn save(img: &LinearImage, path: &Path) -> Result<()> {
     .with_context(|| format!("writing {}", path.display()))
 }
 
+fn save_as(img: &LinearImage, dir: &Path, name: &str, formats: Formats) -> Result<()> {
+    if formats != Formats::Exr {
+        save(img, &dir.join(format!("{name}.png")))?;
+    }
+    if formats != Formats::Png {
+        save(img, &dir.join(format!("{name}.exr")))?;
+    }
+    Ok(())
+}
+
 fn renderer() -> Result<Renderer> {
     let ctx = GpuContext::new_headless()?;
     log::info!("adapter: {}", ctx.describe());
@@ -73,19 +83,21 @@ pub fn render(
     size: (u32, u32),
     spp: u32,
     out: &Path,
+    formats: Formats,
 ) -> Result<()> {
     let prepared = Prepared::new(material)?;
     let r = renderer()?;
     let scene = view.scene();
     let gm = GpuMaterial::new(r.context(), &prepared, scene.camera.target);
     let draw = |m: ViewMode| r.render(&gm, &scene, m, size, spp);
+    let draw = |m: ViewMode| -> Result<LinearImage> { Ok(draw(m)?) };
     match mode {
-        RenderMode::Naive => save(&draw(ViewMode::Naive), out)?,
-        RenderMode::ViewIndependent => save(&draw(ViewMode::ViewIndependent), out)?,
-        RenderMode::Filtered => save(&draw(ViewMode::Filtered), out)?,
-        RenderMode::Truth => save(&draw(ViewMode::Truth), out)?,
+        RenderMode::Naive => save(&draw(ViewMode::Naive)?, out)?,
+        RenderMode::ViewIndependent => save(&draw(ViewMode::ViewIndependent)?, out)?,
+        RenderMode::Filtered => save(&draw(ViewMode::Filtered)?, out)?,
+        RenderMode::Truth => save(&draw(ViewMode::Truth)?, out)?,
         RenderMode::Error => {
-            let (f, t) = (draw(ViewMode::Filtered), draw(ViewMode::Truth));
+            let (f, t) = (draw(ViewMode::Filtered)?, draw(ViewMode::Truth)?);
             let s = error_stats(&f, &t);
             println!(
                 "filtered vs truth: RMSE {:.5}, max {:.5} (legend 0 … {:.5})",
@@ -95,11 +107,11 @@ pub fn render(
         }
         RenderMode::All => {
             std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-            let truth = draw(ViewMode::Truth);
+            let truth = draw(ViewMode::Truth)?;
             let modes = [
-                ("naive", draw(ViewMode::Naive)),
-                ("view_independent", draw(ViewMode::ViewIndependent)),
-                ("filtered", draw(ViewMode::Filtered)),
+                ("naive", draw(ViewMode::Naive)?),
+                ("view_independent", draw(ViewMode::ViewIndependent)?),
+                ("filtered", draw(ViewMode::Filtered)?),
             ];
             // One legend for every error map: the largest error of any mode.
             let scale = modes
@@ -109,8 +121,7 @@ pub fn render(
             for (name, img) in &modes {
                 let s = error_stats(img, &truth);
                 println!("{name:>16} vs truth: RMSE {:.5}, max {:.5}", s.rmse, s.max);
-                save(img, &out.join(format!("{name}.png")))?;
-                save(img, &out.join(format!("{name}.exr")))?;
+                save_as(img, out, name, formats)?;
                 save(
                     &heat_map(img, &truth, scale),
                     &out.join(format!("error_{name}.png")),
@@ -119,8 +130,7 @@ pub fn render(
             println!(
                 "error maps share the legend 0 … {scale:.5} (linear RGB), truth {spp} rays/pixel"
             );
-            save(&truth, &out.join("truth.png"))?;
-            save(&truth, &out.join("truth.exr"))?;
+            save_as(&truth, out, "truth", formats)?;
         }
     }
     Ok(())

@@ -80,3 +80,24 @@ fn eval_prints_json_with_every_method() {
     }
     assert_eq!(v["samples"].as_u64(), Some(2000));
 }
+
+#[test]
+fn no_adapter_exits_3_with_a_clear_message() {
+    // Metal does not exist on Linux or Windows: wgpu finds no adapter at all.
+    if cfg!(target_os = "macos") {
+        return;
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_lodestone"))
+        .args(["adapter"])
+        .env("WGPU_BACKEND", "metal")
+        .output()
+        .expect("run lodestone");
+    assert_eq!(
+        out.status.code(),
+        Some(3),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no GPU adapter"), "{err}");
+}

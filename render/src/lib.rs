@@ -12,4 +12,4 @@ pub mod renderer;
 pub mod shaders;
 
 pub use gpu::{GpuContext, GpuError};
-pub use renderer::{GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget};
+pub use renderer::{GpuMaterial, LinearImage, RenderError, Renderer, Scene, ViewMode, ViewTarget};

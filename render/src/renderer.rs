@@ -16,6 +16,14 @@ use lodestone_core::shadowing::Correlation;
 use lodestone_core::transfer::TransferFunction;
 use std::f64::consts::TAU;
 
+/// Errors while rendering.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// The GPU could not hand the image back (device lost, out of memory, …).
+    #[error("reading the image back from the GPU failed: {0}")]
+    Readback(String),
+}
+
 /// What a view shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ViewMode {
@@ -156,7 +164,7 @@ impl ViewTarget {
     }
 
     /// Read the target back (waits for the GPU).
-    pub fn read(&self, renderer: &Renderer) -> LinearImage {
+    pub fn read(&self, renderer: &Renderer) -> Result<LinearImage, RenderError> {
         let device = &renderer.ctx.device;
         let size = u64::from(self.width) * u64::from(self.height) * 16;
         let readback = device.create_buffer(&wgpu::BufferDescriptor {
@@ -171,21 +179,31 @@ impl ViewTarget {
         enc.copy_buffer_to_buffer(&self.accum, 0, &readback, 0, size);
         renderer.ctx.queue.submit([enc.finish()]);
         let slice = readback.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |r| r.expect("map readback"));
+        let (tx, rx) = std::sync::mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |r| {
+            let _ = tx.send(r);
+        });
         device
             .poll(wgpu::PollType::wait_indefinitely())
-            .expect("device poll");
-        let view = slice.get_mapped_range().expect("mapped range");
+            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        match rx.recv() {
+            Ok(Ok(())) => {}
+            Ok(Err(e)) => return Err(RenderError::Readback(e.to_string())),
+            Err(e) => return Err(RenderError::Readback(e.to_string())),
+        }
+        let view = slice
+            .get_mapped_range()
+            .map_err(|e| RenderError::Readback(format!("{e:?}")))?;
         let floats: &[f32] = bytemuck::cast_slice(&view);
         let pixels = floats
             .chunks_exact(4)
             .map(|c| [c[0], c[1], c[2], c[3]])
             .collect();
-        LinearImage {
+        Ok(LinearImage {
             width: self.width,
             height: self.height,
             pixels,
-        }
+        })
     }
 }
 
@@ -372,7 +390,7 @@ impl Renderer {
         mode: ViewMode,
         (width, height): (u32, u32),
         samples: u32,
-    ) -> LinearImage {
+    ) -> Result<LinearImage, RenderError> {
         let mut target = ViewTarget::new(self, width, height);
         self.draw(&mut target, material, scene, mode, samples);
         target.read(self)
@@ -461,6 +479,10 @@ impl Renderer {
             }
             self.ctx.queue.submit([enc.finish()]);
             target.samples += u32::from(mode == ViewMode::Truth);
+            // Keep the queue short: long progressive runs otherwise pile up thousands of submissions.
+            if target.samples % 8 == 7 {
+                self.wait();
+            }
         }
     }
 

@@ -104,7 +104,7 @@ fn analytic_views_match_core_pixel_by_pixel() {
                 ViewMode::ViewIndependent,
                 ViewMode::Filtered,
             ] {
-                let img = r.render(&gm, &scene, mode, (w, h), 1);
+                let img = r.render(&gm, &scene, mode, (w, h), 1).expect("readback");
                 // Pixels whose f32 (GPU) and f64 (core) rays land on different sides of a silhouette or
                 // shadow edge of the level-of-detail relief legitimately differ; allow 1% of them.
                 let mut off = vec![];
@@ -155,7 +155,9 @@ fn ground_truth_matches_the_cpu_ray_tracer_on_a_far_patch() {
             light: DVec3::Z,
         };
         let gm = GpuMaterial::new(r.context(), &p, camera.target);
-        let img = r.render(&gm, &scene, ViewMode::Truth, (16, 16), 64);
+        let img = r
+            .render(&gm, &scene, ViewMode::Truth, (16, 16), 64)
+            .expect("readback");
         let mut mean = [0.0f64; 3];
         for y in 0..16 {
             for x in 0..16 {
@@ -204,7 +206,9 @@ fn debug_truth_pixels() {
         light: DVec3::Z,
     };
     let gm = GpuMaterial::new(r.context(), &p, camera.target);
-    let img = r.render(&gm, &scene, ViewMode::Truth, (8, 4), 1);
+    let img = r
+        .render(&gm, &scene, ViewMode::Truth, (8, 4), 1)
+        .expect("readback");
     for y in 0..4 {
         let row: Vec<String> = (0..8).map(|x| format!("{:.3}", img.rgb(x, y)[0])).collect();
         let cpu: Vec<String> = (0..8)

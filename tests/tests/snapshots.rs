@@ -23,18 +23,31 @@ fn compare(name: &str, got: &image::RgbaImage) -> Result<(), String> {
     let path = root().join("snapshots").join(format!("{name}.png"));
     let update = std::env::var("UPDATE_SNAPSHOTS").is_ok_and(|v| !v.is_empty() && v != "0");
     if update {
-        got.save(&path).map_err(|e| format!("{name}: cannot write baseline: {e}"))?;
+        got.save(&path)
+            .map_err(|e| format!("{name}: cannot write baseline: {e}"))?;
         return Ok(());
     }
     let want = image::open(&path)
-        .map_err(|e| format!("{name}: missing baseline {} ({e}); run with UPDATE_SNAPSHOTS=1", path.display()))?
+        .map_err(|e| {
+            format!(
+                "{name}: missing baseline {} ({e}); run with UPDATE_SNAPSHOTS=1",
+                path.display()
+            )
+        })?
         .to_rgba8();
     if want.dimensions() != got.dimensions() {
-        return Err(format!("{name}: size {:?} vs baseline {:?}", got.dimensions(), want.dimensions()));
+        return Err(format!(
+            "{name}: size {:?} vs baseline {:?}",
+            got.dimensions(),
+            want.dimensions()
+        ));
     }
     let (mut sum, mut far) = (0.0f64, 0usize);
     for (a, b) in got.pixels().zip(want.pixels()) {
-        let d = (0..3).map(|k| (i32::from(a[k]) - i32::from(b[k])).unsigned_abs()).max().unwrap_or(0);
+        let d = (0..3)
+            .map(|k| (i32::from(a[k]) - i32::from(b[k])).unsigned_abs())
+            .max()
+            .unwrap_or(0);
         sum += f64::from(d);
         far += usize::from(d > 12);
     }
@@ -43,7 +56,10 @@ fn compare(name: &str, got: &image::RgbaImage) -> Result<(), String> {
     if mean > 2.0 || far * 50 > n {
         let diff = root().join("snapshots").join(format!("{name}.new.png"));
         let _ = got.save(&diff);
-        return Err(format!("{name}: mean difference {mean:.2}/255, {far} of {n} pixels off by > 12/255 (new image: {})", diff.display()));
+        return Err(format!(
+            "{name}: mean difference {mean:.2}/255, {far} of {n} pixels off by > 12/255 (new image: {})",
+            diff.display()
+        ));
     }
     Ok(())
 }
@@ -60,14 +76,42 @@ fn views_match_their_snapshots() {
     eprintln!("snapshots on {}", ctx.describe());
     let r = Renderer::new(ctx);
     let views = [
-        ("near", Camera { elevation_deg: 45.0, azimuth_deg: 15.0, distance: 2.0, target: [0.7, 0.2], fov_deg: 35.0 }),
-        ("grazing", Camera { elevation_deg: 84.0, azimuth_deg: -30.0, distance: 4.0, target: [3.0, -1.0], fov_deg: 30.0 }),
-        ("far", Camera { elevation_deg: 60.0, azimuth_deg: 120.0, distance: 150.0, target: [-40.0, 25.0], fov_deg: 30.0 }),
+        (
+            "near",
+            Camera {
+                elevation_deg: 45.0,
+                azimuth_deg: 15.0,
+                distance: 2.0,
+                target: [0.7, 0.2],
+                fov_deg: 35.0,
+            },
+        ),
+        (
+            "grazing",
+            Camera {
+                elevation_deg: 84.0,
+                azimuth_deg: -30.0,
+                distance: 4.0,
+                target: [3.0, -1.0],
+                fov_deg: 30.0,
+            },
+        ),
+        (
+            "far",
+            Camera {
+                elevation_deg: 60.0,
+                azimuth_deg: 120.0,
+                distance: 150.0,
+                target: [-40.0, 25.0],
+                fov_deg: 30.0,
+            },
+        ),
     ];
     let light = direction(40f64.to_radians(), 2.0);
     let mut failures = vec![];
     for preset in ["default", "moss"] {
-        let text = std::fs::read_to_string(root().join("../presets").join(format!("{preset}.ron"))).unwrap();
+        let text = std::fs::read_to_string(root().join("../presets").join(format!("{preset}.ron")))
+            .unwrap();
         let prepared = Prepared::new(&Material::from_ron(&text).unwrap()).unwrap();
         for (view, camera) in views {
             let scene = Scene { camera, light };
@@ -78,7 +122,10 @@ fn views_match_their_snapshots() {
                 ("filtered", ViewMode::Filtered),
                 ("truth", ViewMode::Truth),
             ] {
-                let img = r.render(&gm, &scene, mode, SIZE, TRUTH_SAMPLES).to_srgb8();
+                let img = r
+                    .render(&gm, &scene, mode, SIZE, TRUTH_SAMPLES)
+                    .expect("readback")
+                    .to_srgb8();
                 if let Err(e) = compare(&format!("{preset}-{view}-{mode_name}"), &img) {
                     failures.push(e);
                 }

@@ -599,53 +599,56 @@ fn trace_ray(origin: vec3<f32>, dir: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
 }
 
 // ---------------------------------------------------------------- footprint.rs (level-of-detail surface)
-// f̄(x) for the footprint (Prepared::lod_height needs only the mean and the constant σ_f).
-fn lod_mean(x: vec2<f32>, fp: vec3<f32>) -> f32 {
-    var m = 0.0;
-    for (var i = 0u; i < params.wave_count; i = i + 1u) {
-        let w = wave(i);
-        let q = w.x * w.x * fp.x + 2.0 * w.x * w.y * fp.z + w.y * w.y * fp.y;
-        m = m + w.z * exp(-2.0 * PI * PI * q) * cos(TAU * dot(w.xy, x) + w.w);
-    }
-    return m;
-}
+// Per-invocation cache of each wave's footprint attenuation exp(−2π² kᵀΣk): constant along a pixel's
+// rays, so the march evaluates only cosines per step. Filled by lod_prepare (MAX_COMPONENTS = 256).
+var<private> lod_att: array<f32, 256>;
 
-// Phase-averaged footprint std σ_f (constant over x).
-fn lod_sigma_f(fp: vec3<f32>) -> f32 {
+// Fill lod_att for footprint fp; returns the phase-averaged footprint std σ_f.
+fn lod_prepare(fp: vec3<f32>) -> f32 {
     var v = 0.0;
     for (var i = 0u; i < params.wave_count; i = i + 1u) {
         let w = wave(i);
         let q = w.x * w.x * fp.x + 2.0 * w.x * w.y * fp.z + w.y * w.y * fp.y;
         let g = exp(-2.0 * PI * PI * q);
+        lod_att[i] = g;
         v = v + w.z * w.z * (1.0 - g * g) * 0.5;
     }
     return sqrt(max(v, 0.0));
 }
 
+// f̄(x) with the cached attenuations.
+fn lod_mean(x: vec2<f32>) -> f32 {
+    var m = 0.0;
+    for (var i = 0u; i < params.wave_count; i = i + 1u) {
+        let w = wave(i);
+        m = m + w.z * lod_att[i] * cos(TAU * dot(w.xy, x) + w.w);
+    }
+    return m;
+}
+
 // Prepared::lod_height.
-fn lod_height(x: vec2<f32>, fp: vec3<f32>, sf: f32) -> f32 {
-    return params.sigma_h * transfer_moments(lod_mean(x, fp), sf).x;
+fn lod_height(x: vec2<f32>, sf: f32) -> f32 {
+    return params.sigma_h * transfer_moments(lod_mean(x), sf).x;
 }
 
 // Prepared::lod_rate.
-fn lod_rate(d: vec3<f32>, fp: vec3<f32>) -> f32 {
+fn lod_rate(d: vec3<f32>) -> f32 {
     let r = length(d.xy);
     var k = 0.0;
     if (r > 0.0) {
         let dir = d.xy / r;
         for (var i = 0u; i < params.wave_count; i = i + 1u) {
             let w = wave(i);
-            let q = w.x * w.x * fp.x + 2.0 * w.x * w.y * fp.z + w.y * w.y * fp.y;
-            k = k + abs(w.z) * exp(-2.0 * PI * PI * q) * TAU * abs(dot(w.xy, dir));
+            k = k + abs(w.z) * lod_att[i] * TAU * abs(dot(w.xy, dir));
         }
         k = k * params.sigma_h * params.g_lip;
     }
     return abs(d.z) + k * r;
 }
 
-// Prepared::lod_march: t of the first crossing of h̄, or -1.
-fn lod_march(o: vec3<f32>, d: vec3<f32>, fp: vec3<f32>, sf: f32) -> f32 {
-    let rate = lod_rate(d, fp);
+// Prepared::lod_march: t of the first crossing of h̄, or -1 (needs lod_prepare first).
+fn lod_march(o: vec3<f32>, d: vec3<f32>, sf: f32) -> f32 {
+    let rate = lod_rate(d);
     if (rate <= 0.0) {
         return -1.0;
     }
@@ -657,7 +660,7 @@ fn lod_march(o: vec3<f32>, d: vec3<f32>, fp: vec3<f32>, sf: f32) -> f32 {
         if ((d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0)) {
             return -1.0;
         }
-        var gap = p.z - lod_height(p.xy, fp, sf);
+        var gap = p.z - lod_height(p.xy, sf);
         if (gap < 0.0 && t == 0.0) {
             gap = 0.0;
         }
@@ -667,7 +670,7 @@ fn lod_march(o: vec3<f32>, d: vec3<f32>, fp: vec3<f32>, sf: f32) -> f32 {
             for (var j = 0u; j < 24u; j = j + 1u) {
                 let m = 0.5 * (a + b);
                 let q = o + d * m;
-                if (q.z - lod_height(q.xy, fp, sf) >= 0.0) {
+                if (q.z - lod_height(q.xy, sf) >= 0.0) {
                     a = m;
                 } else {
                     b = m;
@@ -686,16 +689,16 @@ fn analytic_pixel(method: u32, origin: vec3<f32>, dir: vec3<f32>, wi: vec3<f32>,
     if (dir.z >= 0.0) {
         return vec3<f32>(0.0);
     }
-    let sf = lod_sigma_f(fp);
+    let sf = lod_prepare(fp);
     let top = params.h_max * 1.001 + 1e-6;
     let t0 = max((origin.z - top) / -dir.z, 0.0);
     let o = origin + dir * t0;
-    let t = lod_march(o, dir, fp, sf);
+    let t = lod_march(o, dir, sf);
     if (t < 0.0) {
         return vec3<f32>(0.0);
     }
     let p = o + dir * t;
-    if (wi.z <= 0.0 || lod_march(p, wi, fp, sf) >= 0.0) {
+    if (wi.z <= 0.0 || lod_march(p, wi, sf) >= 0.0) {
         return vec3<f32>(0.0);
     }
     if (method == 0u) {

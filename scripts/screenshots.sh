@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# Regenerate screenshots/views/: every mode and error map of three presets at a near-grazing view.
+# Usage: bash scripts/screenshots.sh   (uses the release build; ~10 minutes on llvmpipe, seconds on a GPU)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+cargo build --release -q
+for preset in default moss dirt-in-crevices; do
+    ./target/release/lodestone --preset "presets/$preset.ron" render --mode all --formats png \
+        --view-deg 70 --light-deg 50 --light-azimuth-deg 120 --distance 8 --size 480x270 --spp 64 \
+        --out "screenshots/views/$preset" | tee "screenshots/views/$preset.txt"
+done
