@@ -31,7 +31,7 @@ use crate::quadrature::gauss_hermite_normal;
 use crate::shadowing::MaskingShadowing;
 use crate::slopes::SlopeCov;
 use crate::special::{erf, norm_cdf, norm_pdf};
-use crate::surface::{Surface, Trace};
+use crate::surface::{Surface, Trace, march_heightfield};
 use crate::transfer::{SurfaceStats, TransferFunction, TransferMoments, transformed_statistics};
 use glam::{DVec2, DVec3};
 use rayon::prelude::*;
@@ -342,7 +342,9 @@ impl Prepared {
 
     /// One eye ray through the mean-plane point y: its radiance.
     fn trace_pixel_sample(&self, y: DVec2, cfg: &Config) -> [f64; 3] {
-        let origin = DVec3::new(y.x, y.y, 0.0) + cfg.wo * 1.0;
+        // Start above the slab: z = h_max·1.001 + margin, on the eye ray through (y, 0).
+        let lift = (self.surface.h_max * 1.001 + 1e-6) / cfg.wo.z + 1.0;
+        let origin = DVec3::new(y.x, y.y, 0.0) + cfg.wo * lift;
         self.trace_ray(origin, -cfg.wo, cfg.wi)
     }
 
@@ -418,43 +420,12 @@ impl Prepared {
         d.z.abs() + k * r
     }
 
-    /// March `o + t·d` against h̄ (same rule as [`Surface::march`]): the first crossing, if any.
+    /// March `o + t·d` against h̄ (the same [`march_heightfield`] as the explicit surface).
     pub fn lod_march(&self, o: DVec3, d: DVec3, fp: Footprint) -> Option<f64> {
-        let rate = self.lod_rate(d, fp);
-        if rate <= 0.0 {
-            return None;
-        }
-        let top = self.surface.h_max * (1.0 + 1e-12) + 1e-300;
-        let gap = |t: f64| {
-            let p = o + d * t;
-            p.z - self.lod_height(DVec2::new(p.x, p.y), fp)
-        };
-        let (mut t, mut prev) = (0.0, 0.0);
-        for _ in 0..100_000 {
-            let p = o + d * t;
-            if (d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0) {
-                return None;
-            }
-            let mut g = gap(t);
-            if g < 0.0 && t == 0.0 {
-                g = 0.0; // the origin is on the surface: rounding
-            }
-            if g < 0.0 {
-                let (mut a, mut b) = (prev, t);
-                for _ in 0..48 {
-                    let m = 0.5 * (a + b);
-                    if gap(m) >= 0.0 {
-                        a = m;
-                    } else {
-                        b = m;
-                    }
-                }
-                return Some(a);
-            }
-            prev = t;
-            t += (g / rate).max(self.surface.min_step);
-        }
-        None
+        let s = &self.surface;
+        march_heightfield(o, d, self.lod_rate(d, fp), s.h_max, s.min_step, |x| {
+            self.lod_height(x, fp)
+        })
     }
 
     /// One pixel of an analytic view: the camera ray (origin, unit dir) meets the level-of-detail

@@ -96,50 +96,10 @@ impl Surface {
             0.0
         };
         let rate = d.z.abs() + k * r;
-        if rate <= 0.0 {
-            return Trace::Escape;
+        match march_heightfield(o, d, rate, self.h_max, self.min_step, |x| self.height(x)) {
+            Some(t) => Trace::Hit(t),
+            None => Trace::Escape,
         }
-        let top = self.h_max * (1.0 + 1e-12) + 1e-300;
-        let bottom = -top;
-        let mut t = 0.0;
-        let mut prev = 0.0;
-        for _ in 0..1_000_000 {
-            let p = o + d * t;
-            if (d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < bottom - 1.0) {
-                return Trace::Escape;
-            }
-            let mut gap = p.z - self.height(DVec2::new(p.x, p.y));
-            if gap < 0.0 {
-                if t == 0.0 {
-                    // The origin is on the surface by contract: a negative gap here is rounding.
-                    gap = 0.0;
-                } else {
-                    return Trace::Hit(self.bisect(o, d, prev, t));
-                }
-            }
-            prev = t;
-            t += (gap / rate).max(self.min_step);
-        }
-        Trace::Escape
-    }
-
-    /// Refine the crossing in [a, b], where the gap is ≥ 0 at a and < 0 at b, by 48 bisections;
-    /// returns the upper end (a point just above the surface). Only a step of `min_step` can hold
-    /// two crossings, so this is the first crossing up to that tolerance.
-    fn bisect(&self, o: DVec3, d: DVec3, mut a: f64, mut b: f64) -> f64 {
-        let gap = |t: f64| {
-            let p = o + d * t;
-            p.z - self.height(DVec2::new(p.x, p.y))
-        };
-        for _ in 0..48 {
-            let m = 0.5 * (a + b);
-            if gap(m) >= 0.0 {
-                a = m;
-            } else {
-                b = m;
-            }
-        }
-        a
     }
 
     /// Whether the point p (on the surface) sees direction d (unit): false if d is at or below the
@@ -150,6 +110,55 @@ impl Surface {
         }
         matches!(self.march(p, d), Trace::Escape)
     }
+}
+
+/// Sphere tracing on any heightfield `height` bounded by |h| ≤ `h_max`, along `p(t) = o + t·d`,
+/// with `rate` a bound on how fast the gap `z − h` can change per unit t (see the module docs). Steps
+/// `max(gap/rate, min_step)`; a sign change is refined by 48 bisections, returning the last point
+/// above the surface. A negative gap at t = 0 is rounding (the origin is on the surface by contract).
+/// `None` when the ray leaves the slab. Shared by the explicit surface and the level-of-detail surface.
+pub fn march_heightfield(
+    o: DVec3,
+    d: DVec3,
+    rate: f64,
+    h_max: f64,
+    min_step: f64,
+    height: impl Fn(DVec2) -> f64,
+) -> Option<f64> {
+    if !(rate > 0.0) {
+        return None;
+    }
+    let top = h_max * (1.0 + 1e-12) + 1e-300;
+    let gap = |t: f64| {
+        let p = o + d * t;
+        p.z - height(DVec2::new(p.x, p.y))
+    };
+    let (mut t, mut prev) = (0.0, 0.0);
+    for _ in 0..1_000_000 {
+        let p = o + d * t;
+        if (d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0) {
+            return None;
+        }
+        let mut g = gap(t);
+        if g < 0.0 && t == 0.0 {
+            g = 0.0;
+        }
+        if g < 0.0 {
+            let (mut a, mut b) = (prev, t);
+            for _ in 0..48 {
+                let m = 0.5 * (a + b);
+                if gap(m) >= 0.0 {
+                    a = m;
+                } else {
+                    b = m;
+                }
+            }
+            return Some(a);
+        }
+        prev = t;
+        t += (g / rate).max(min_step);
+    }
+    None
 }
 
 #[cfg(test)]

@@ -188,35 +188,3 @@ fn ground_truth_matches_the_cpu_ray_tracer_on_a_far_patch() {
         );
     }
 }
-
-#[test]
-#[ignore = "debugging aid"]
-fn debug_truth_pixels() {
-    let Some(r) = renderer() else { return };
-    let p = Prepared::new(&preset("default.ron")).unwrap();
-    let camera = Camera {
-        elevation_deg: 60.0,
-        azimuth_deg: 0.0,
-        distance: 2000.0,
-        target: [5.0, 3.0],
-        fov_deg: 2.0,
-    };
-    let scene = Scene {
-        camera,
-        light: DVec3::Z,
-    };
-    let gm = GpuMaterial::new(r.context(), &p, camera.target);
-    let img = r
-        .render(&gm, &scene, ViewMode::Truth, (8, 4), 1)
-        .expect("readback");
-    for y in 0..4 {
-        let row: Vec<String> = (0..8).map(|x| format!("{:.3}", img.rgb(x, y)[0])).collect();
-        let cpu: Vec<String> = (0..8)
-            .map(|x| {
-                let ray = camera.ray(DVec2::new(x as f64 + 0.5, y as f64 + 0.5), 8, 4);
-                format!("{:.3}", p.trace_ray(ray.origin, ray.dir, DVec3::Z)[0])
-            })
-            .collect();
-        eprintln!("gpu {row:?}\ncpu {cpu:?}");
-    }
-}

@@ -524,15 +524,18 @@ fn lipschitz_along(dir: vec2<f32>) -> f32 {
     return params.sigma_h * params.g_lip * s;
 }
 
-// Surface::march: t of the first crossing, or -1 when the ray escapes. o on or above the surface.
-fn march(o: vec3<f32>, d: vec3<f32>) -> f32 {
-    let r = length(d.xy);
-    var k = 0.0;
-    if (r > 0.0) {
-        k = lipschitz_along(d.xy / r);
+// Height of the explicit surface (lod = false) or of the level-of-detail surface (lod = true, needs
+// lod_prepare first).
+fn field_height(x: vec2<f32>, lod: bool, sf: f32) -> f32 {
+    if (lod) {
+        return lod_height(x, sf);
     }
-    let rate = abs(d.z) + k * r;
-    if (rate <= 0.0) {
+    return surface_height(x);
+}
+
+// surface::march_heightfield: t of the first crossing, or -1 when the ray leaves the slab.
+fn march_heightfield(o: vec3<f32>, d: vec3<f32>, rate: f32, lod: bool, sf: f32) -> f32 {
+    if (!(rate > 0.0)) {
         return -1.0;
     }
     let top = params.h_max * (1.0 + 1e-6) + 1e-30;
@@ -543,7 +546,7 @@ fn march(o: vec3<f32>, d: vec3<f32>) -> f32 {
         if ((d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0)) {
             return -1.0;
         }
-        var gap = p.z - surface_height(p.xy);
+        var gap = p.z - field_height(p.xy, lod, sf);
         if (gap < 0.0 && t == 0.0) {
             // The origin is on the surface by contract: a negative gap here is rounding.
             gap = 0.0;
@@ -554,7 +557,7 @@ fn march(o: vec3<f32>, d: vec3<f32>) -> f32 {
             for (var j = 0u; j < 24u; j = j + 1u) {
                 let m = 0.5 * (a + b);
                 let q = o + d * m;
-                if (q.z - surface_height(q.xy) >= 0.0) {
+                if (q.z - field_height(q.xy, lod, sf) >= 0.0) {
                     a = m;
                 } else {
                     b = m;
@@ -566,6 +569,16 @@ fn march(o: vec3<f32>, d: vec3<f32>) -> f32 {
         t = t + max(gap / rate, params.min_step);
     }
     return -1.0;
+}
+
+// Surface::march.
+fn march(o: vec3<f32>, d: vec3<f32>) -> f32 {
+    let r = length(d.xy);
+    var k = 0.0;
+    if (r > 0.0) {
+        k = lipschitz_along(d.xy / r);
+    }
+    return march_heightfield(o, d, abs(d.z) + k * r, false, 0.0);
 }
 
 fn sees(p: vec3<f32>, d: vec3<f32>) -> bool {
@@ -648,40 +661,7 @@ fn lod_rate(d: vec3<f32>) -> f32 {
 
 // Prepared::lod_march: t of the first crossing of h̄, or -1 (needs lod_prepare first).
 fn lod_march(o: vec3<f32>, d: vec3<f32>, sf: f32) -> f32 {
-    let rate = lod_rate(d);
-    if (rate <= 0.0) {
-        return -1.0;
-    }
-    let top = params.h_max * (1.0 + 1e-6) + 1e-30;
-    var t = 0.0;
-    var prev = 0.0;
-    for (var it = 0u; it < 20000u; it = it + 1u) {
-        let p = o + d * t;
-        if ((d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0)) {
-            return -1.0;
-        }
-        var gap = p.z - lod_height(p.xy, sf);
-        if (gap < 0.0 && t == 0.0) {
-            gap = 0.0;
-        }
-        if (gap < 0.0) {
-            var a = prev;
-            var b = t;
-            for (var j = 0u; j < 24u; j = j + 1u) {
-                let m = 0.5 * (a + b);
-                let q = o + d * m;
-                if (q.z - lod_height(q.xy, sf) >= 0.0) {
-                    a = m;
-                } else {
-                    b = m;
-                }
-            }
-            return a;
-        }
-        prev = t;
-        t = t + max(gap / rate, params.min_step);
-    }
-    return -1.0;
+    return march_heightfield(o, d, lod_rate(d), true, sf);
 }
 
 // Prepared::pixel: method 0 naive, 1 view-independent, 2 filtered.
