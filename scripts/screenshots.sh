@@ -6,6 +6,6 @@ cd "$(dirname "$0")/.."
 cargo build --release -q
 for preset in default moss dirt-in-crevices; do
     ./target/release/lodestone --preset "presets/$preset.ron" render --mode all --formats png \
-        --view-deg 70 --light-deg 50 --light-azimuth-deg 120 --distance 8 --size 480x270 --spp 64 \
+        --view-deg 70 --light-deg 50 --light-azimuth-deg 120 --distance 8 --size 480x270 --spp 1024 \
         --out "screenshots/views/$preset" | tee "screenshots/views/$preset.txt"
 done
