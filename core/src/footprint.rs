@@ -280,7 +280,13 @@ impl Prepared {
         let diffuse = brdf.albedo
             * FRAC_1_PI
             * visible_slope_mean(&sigma, wo, points, |n| n.dot(wi).max(0.0));
-        let spec = filtered_specular(brdf.specular, brdf.roughness, &sigma, wo, wi);
+        let spec = filtered_specular(
+            brdf.specular,
+            brdf.roughness,
+            &sigma,
+            (wo, wi),
+            (cfg.wo, cfg.wi),
+        );
         color.map(|c| vbar * (c * diffuse + spec))
     }
 
@@ -537,13 +543,23 @@ pub fn visible_slope_mean(sigma: &SlopeCov, wo: DVec3, n: usize, q: impl Fn(DVec
 
 /// Specular averaged over D_s: `F0·N(s_h; 0, Σ + σ0²I)·u⁺(s_h) / (4 h_z⁴ ωo_z E[u⁺])` with
 /// `u(s) = ωo_z − s·ωo_xy` and `E[u⁺] = mΦ(r) + √v φ(r)`, `m = ωo_z`, `v = ωo_xyᵀΣωo_xy`, `r = m/√v`
-/// (design.md, "Visible slope distribution").
-pub fn filtered_specular(f0: f64, roughness: f64, sigma: &SlopeCov, wo: DVec3, wi: DVec3) -> f64 {
-    if f0 <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0 {
+/// (design.md, "Visible slope distribution"). Slopes and the D_s weighting are taken in the local
+/// (resolved-normal) frame `local`; the lobe's prefactor `1/(4 h_z⁴ ωo_z)` in the macro frame `world`,
+/// exactly as the explicit facets define it ([`crate::brdf`]), so it stays bounded where the viewer
+/// grazes a resolved bump.
+pub fn filtered_specular(
+    f0: f64,
+    roughness: f64,
+    sigma: &SlopeCov,
+    (wo, wi): (DVec3, DVec3),
+    (wo_w, wi_w): (DVec3, DVec3),
+) -> f64 {
+    if f0 <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0 || wo_w.z <= 0.0 || wi_w.z <= 0.0 {
         return 0.0;
     }
     let h = (wo + wi).normalize();
-    if h.z <= 1e-9 {
+    let hw = (wo_w + wi_w).normalize();
+    if h.z <= 1e-9 || hw.z <= 1e-9 {
         return 0.0;
     }
     let sh = slope_of(h);
@@ -557,7 +573,7 @@ pub fn filtered_specular(f0: f64, roughness: f64, sigma: &SlopeCov, wo: DVec3, w
         wo.z
     };
     let d = gaussian2(sh, *sigma + SlopeCov::isotropic(roughness.max(0.0)));
-    f0 * d * u_h / (4.0 * h.z.powi(4) * wo.z * eu.max(1e-300))
+    f0 * d * (u_h / eu.max(1e-300)) / (4.0 * hw.z.powi(4) * wo_w.z)
 }
 
 /// A standard normal draw (SplitMix64 + Box–Muller).

@@ -375,12 +375,14 @@ fn visible_slope_mean_cos(cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     return 0.0;
 }
 
-fn filtered_specular(cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
-    if (params.specular <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0) {
+// footprint::filtered_specular: slopes and D_s in the local frame, prefactor in the macro frame.
+fn filtered_specular(cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>) -> f32 {
+    if (params.specular <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0 || wo_w.z <= 0.0 || wi_w.z <= 0.0) {
         return 0.0;
     }
     let h = normalize(wo + wi);
-    if (h.z <= 1e-9) {
+    let hw = normalize(wo_w + wi_w);
+    if (h.z <= 1e-9 || hw.z <= 1e-9) {
         return 0.0;
     }
     let sh = slope_of(h);
@@ -394,7 +396,7 @@ fn filtered_specular(cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     }
     let s0 = max(params.roughness, 0.0);
     let d = gaussian2(sh, cov + vec3<f32>(s0 * s0, s0 * s0, 0.0));
-    return params.specular * d * u_h / (4.0 * pow(h.z, 4.0) * wo.z * max(eu, 1e-30));
+    return params.specular * d * (u_h / max(eu, 1e-30)) / (4.0 * pow(hw.z, 4.0) * wo_w.z);
 }
 
 // Prepared::point_input: (colour-map input, standardized height) at driver value f.
@@ -506,7 +508,7 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>)
         vbar = mean_shadowing(ms);
     }
     let diffuse = params.albedo * FRAC_1_PI * visible_slope_mean_cos(cov, wo, wi);
-    let spec = filtered_specular(cov, wo, wi);
+    let spec = filtered_specular(cov, wo, wi, wo_w, wi_w);
     return vbar * (color * diffuse + vec3<f32>(spec));
 }
 
