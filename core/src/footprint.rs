@@ -276,17 +276,13 @@ impl Prepared {
             0.0
         };
         let brdf = &self.material.brdf;
+        // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
+        let mean = loc.stats.slope_mean;
         let points = f.slope_points as usize;
         let diffuse = brdf.albedo
             * FRAC_1_PI
-            * visible_slope_mean(&sigma, wo, points, |n| n.dot(wi).max(0.0));
-        let spec = filtered_specular(
-            brdf.specular,
-            brdf.roughness,
-            &sigma,
-            (wo, wi),
-            (cfg.wo, cfg.wi),
-        );
+            * visible_slope_mean(mean, &sigma, cfg.wo, points, |n| n.dot(cfg.wi).max(0.0));
+        let spec = filtered_specular(brdf.specular, brdf.roughness, mean, &sigma, cfg.wo, cfg.wi);
         color.map(|c| vbar * (c * diffuse + spec))
     }
 
@@ -521,15 +517,22 @@ pub fn hermite_rule(n: usize) -> &'static (Vec<f64>, Vec<f64>) {
     RULES[n - 1].get_or_init(|| gauss_hermite_normal(n))
 }
 
-/// E over the visible slope distribution D_s ∝ N(s; 0, Σ)·(ωo_z − s·ωo_xy)⁺ [HNPN14 Sec. 5.2] of
-/// q(n(s)), by n×n Gauss–Hermite over N(0, Σ) (the material's `filtering.slope_points`).
-pub fn visible_slope_mean(sigma: &SlopeCov, wo: DVec3, n: usize, q: impl Fn(DVec3) -> f64) -> f64 {
+/// E over the visible slope distribution D_s ∝ N(s; s̄, Σ)·(ωo_z − s·ωo_xy)⁺ [HNPN14 Sec. 5.2] of
+/// q(n(s)), in world slope space, by n×n Gauss–Hermite over N(s̄, Σ) (the material's
+/// `filtering.slope_points`).
+pub fn visible_slope_mean(
+    mean: DVec2,
+    sigma: &SlopeCov,
+    wo: DVec3,
+    n: usize,
+    q: impl Fn(DVec3) -> f64,
+) -> f64 {
     let (x, w) = hermite_rule(n);
     let (l11, l21, l22) = cholesky(sigma.xx, sigma.xy, sigma.yy);
     let (mut num, mut den) = (0.0, 0.0);
     for (xa, wa) in x.iter().zip(w) {
         for (xb, wb) in x.iter().zip(w) {
-            let s = DVec2::new(l11 * xa, l21 * xa + l22 * xb);
+            let s = mean + DVec2::new(l11 * xa, l21 * xa + l22 * xb);
             let u = (wo.z - s.x * wo.x - s.y * wo.y).max(0.0);
             let wt = wa * wb * u;
             if wt > 0.0 {
@@ -541,39 +544,39 @@ pub fn visible_slope_mean(sigma: &SlopeCov, wo: DVec3, n: usize, q: impl Fn(DVec
     if den > 0.0 { num / den } else { 0.0 }
 }
 
-/// Specular averaged over D_s: `F0·N(s_h; 0, Σ + σ0²I)·u⁺(s_h) / (4 h_z⁴ ωo_z E[u⁺])` with
-/// `u(s) = ωo_z − s·ωo_xy` and `E[u⁺] = mΦ(r) + √v φ(r)`, `m = ωo_z`, `v = ωo_xyᵀΣωo_xy`, `r = m/√v`
-/// (design.md, "Visible slope distribution"). Slopes and the D_s weighting are taken in the local
-/// (resolved-normal) frame `local`; the lobe's prefactor `1/(4 h_z⁴ ωo_z)` in the macro frame `world`,
-/// exactly as the explicit facets define it ([`crate::brdf`]), so it stays bounded where the viewer
-/// grazes a resolved bump.
+/// Specular averaged over D_s, in world slope space with facet slopes `s ~ N(s̄, Σ)`:
+/// `F0·N(s_h − s̄; Σ + σ0²I)·u⁺(s_h) / (4 h_z⁴ ωo_z E[u⁺])`, `u(s) = ωo_z − s·ωo_xy`,
+/// `E[u⁺] = mΦ(r) + √v φ(r)` with `m = ωo_z − s̄·ωo_xy`, `v = ωo_xyᵀΣωo_xy`, `r = m/√v`
+/// (design.md, "Visible slope distribution"): the footprint average of the explicit facets' lobe
+/// ([`crate::brdf`]), with u taken at the lobe's centre.
 pub fn filtered_specular(
     f0: f64,
     roughness: f64,
+    mean: DVec2,
     sigma: &SlopeCov,
-    (wo, wi): (DVec3, DVec3),
-    (wo_w, wi_w): (DVec3, DVec3),
+    wo: DVec3,
+    wi: DVec3,
 ) -> f64 {
-    if f0 <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0 || wo_w.z <= 0.0 || wi_w.z <= 0.0 {
+    if f0 <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0 {
         return 0.0;
     }
     let h = (wo + wi).normalize();
-    let hw = (wo_w + wi_w).normalize();
-    if h.z <= 1e-9 || hw.z <= 1e-9 {
+    if h.z <= 1e-9 {
         return 0.0;
     }
     let sh = slope_of(h);
     let u_h = (wo.z - sh.x * wo.x - sh.y * wo.y).max(0.0);
+    let m = wo.z - mean.x * wo.x - mean.y * wo.y;
     let v = wo.x * wo.x * sigma.xx + 2.0 * wo.x * wo.y * sigma.xy + wo.y * wo.y * sigma.yy;
     let eu = if v > 1e-300 {
         let sv = v.sqrt();
-        let r = (wo.z / sv).min(40.0);
-        wo.z * norm_cdf(r) + sv * norm_pdf(r)
+        let r = (m / sv).clamp(-40.0, 40.0);
+        m * norm_cdf(r) + sv * norm_pdf(r)
     } else {
-        wo.z
+        m.max(0.0)
     };
-    let d = gaussian2(sh, *sigma + SlopeCov::isotropic(roughness.max(0.0)));
-    f0 * d * (u_h / eu.max(1e-300)) / (4.0 * hw.z.powi(4) * wo_w.z)
+    let d = gaussian2(sh - mean, *sigma + SlopeCov::isotropic(roughness.max(0.0)));
+    f0 * d * (u_h / eu.max(1e-300)) / (4.0 * h.z.powi(4) * wo.z)
 }
 
 /// A standard normal draw (SplitMix64 + Box–Muller).

@@ -348,8 +348,8 @@ fn cholesky(c: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(l11, l21, sqrt(max(c.y - l21 * l21, 0.0)));
 }
 
-// visible_slope_mean with q(n) = (n·ωi)⁺, n×n Gauss–Hermite (nodes/weights at gh_offset).
-fn visible_slope_mean_cos(cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+// visible_slope_mean with q(n) = (n·ωi)⁺, world slope space, slopes N(mean, cov), n×n Gauss–Hermite.
+fn visible_slope_mean_cos(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     let l = cholesky(cov);
     let n = params.slope_points;
     var num = 0.0;
@@ -360,7 +360,7 @@ fn visible_slope_mean_cos(cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
         for (var b = 0u; b < n; b = b + 1u) {
             let xb = data[params.gh_offset + 2u * b];
             let wb = data[params.gh_offset + 2u * b + 1u];
-            let s = vec2<f32>(l.x * xa, l.y * xa + l.z * xb);
+            let s = mean + vec2<f32>(l.x * xa, l.y * xa + l.z * xb);
             let u = max(wo.z - s.x * wo.x - s.y * wo.y, 0.0);
             let wt = wa * wb * u;
             if (wt > 0.0) {
@@ -375,28 +375,28 @@ fn visible_slope_mean_cos(cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
     return 0.0;
 }
 
-// footprint::filtered_specular: slopes and D_s in the local frame, prefactor in the macro frame.
-fn filtered_specular(cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>) -> f32 {
-    if (params.specular <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0 || wo_w.z <= 0.0 || wi_w.z <= 0.0) {
+// footprint::filtered_specular (world slope space, facet slopes N(mean, cov)).
+fn filtered_specular(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+    if (params.specular <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0) {
         return 0.0;
     }
     let h = normalize(wo + wi);
-    let hw = normalize(wo_w + wi_w);
-    if (h.z <= 1e-9 || hw.z <= 1e-9) {
+    if (h.z <= 1e-9) {
         return 0.0;
     }
     let sh = slope_of(h);
     let u_h = max(wo.z - sh.x * wo.x - sh.y * wo.y, 0.0);
+    let m = wo.z - mean.x * wo.x - mean.y * wo.y;
     let v = wo.x * wo.x * cov.x + 2.0 * wo.x * wo.y * cov.z + wo.y * wo.y * cov.y;
-    var eu = wo.z;
+    var eu = max(m, 0.0);
     if (v > 1e-30) {
         let sv = sqrt(v);
-        let r = min(wo.z / sv, 40.0);
-        eu = wo.z * norm_cdf(r) + sv * norm_pdf(r);
+        let r = clamp(m / sv, -40.0, 40.0);
+        eu = m * norm_cdf(r) + sv * norm_pdf(r);
     }
     let s0 = max(params.roughness, 0.0);
-    let d = gaussian2(sh, cov + vec3<f32>(s0 * s0, s0 * s0, 0.0));
-    return params.specular * d * (u_h / max(eu, 1e-30)) / (4.0 * pow(hw.z, 4.0) * wo_w.z);
+    let d = gaussian2(sh - mean, cov + vec3<f32>(s0 * s0, s0 * s0, 0.0));
+    return params.specular * d * (u_h / max(eu, 1e-30)) / (4.0 * pow(h.z, 4.0) * wo.z);
 }
 
 // Prepared::point_input: (colour-map input, standardized height) at driver value f.
@@ -507,8 +507,10 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>)
     if (wi.z > 0.0 && wi_w.z > 0.0) {
         vbar = mean_shadowing(ms);
     }
-    let diffuse = params.albedo * FRAC_1_PI * visible_slope_mean_cos(cov, wo, wi);
-    let spec = filtered_specular(cov, wo, wi, wo_w, wi_w);
+    // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
+    let s_mean = loc.stats.slope_mean;
+    let diffuse = params.albedo * FRAC_1_PI * visible_slope_mean_cos(s_mean, cov, wo_w, wi_w);
+    let spec = filtered_specular(s_mean, cov, wo_w, wi_w);
     return vbar * (color * diffuse + vec3<f32>(spec));
 }
 
