@@ -112,11 +112,19 @@ impl Surface {
     }
 }
 
+/// Over-relaxation factor of the march (after Keinert et al. 2014, "Enhanced Sphere Tracing").
+pub const RELAXATION: f64 = 1.6;
+
 /// Sphere tracing on any heightfield `height` bounded by |h| ≤ `h_max`, along `p(t) = o + t·d`,
-/// with `rate` a bound on how fast the gap `z − h` can change per unit t (see the module docs). Steps
-/// `max(gap/rate, min_step)`; a sign change is refined by 48 bisections, returning the last point
-/// above the surface. A negative gap at t = 0 is rounding (the origin is on the surface by contract).
-/// `None` when the ray leaves the slab. Shared by the explicit surface and the level-of-detail surface.
+/// with `rate` a bound on how fast the gap `z − h` can change per unit t (see the module docs).
+///
+/// At a point with gap g ≥ 0 no crossing lies within `g/rate` on either side. Steps are over-relaxed
+/// (`RELAXATION·g/rate`); before anything else is concluded at the new point (a hit, or leaving the
+/// slab), the safe intervals of the two points must cover everything between them, otherwise the march
+/// backs off to the end of the previous safe interval and steps unrelaxed — so relaxation never skips
+/// a crossing. Steps are at least `min_step`; a sign change is refined by 48 bisections, returning the
+/// last point above the surface. A negative gap at t = 0 is rounding (the origin is on the surface by
+/// contract). `None` when the ray leaves the slab. Shared by the explicit and the level-of-detail surface.
 pub fn march_heightfield(
     o: DVec3,
     d: DVec3,
@@ -133,18 +141,26 @@ pub fn march_heightfield(
         let p = o + d * t;
         p.z - height(DVec2::new(p.x, p.y))
     };
-    let (mut t, mut prev) = (0.0, 0.0);
+    let (mut t, mut prev_t, mut prev_r) = (0.0_f64, 0.0_f64, 0.0_f64);
+    let mut relaxed = false;
     for _ in 0..1_000_000 {
         let p = o + d * t;
-        if (d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0) {
-            return None;
-        }
         let mut g = gap(t);
         if g < 0.0 && t == 0.0 {
             g = 0.0;
         }
+        let r = g.max(0.0) / rate;
+        if relaxed && t - prev_t > prev_r + r {
+            // The relaxed step left a stretch no safe interval covers: back off and step safely.
+            t = prev_t + prev_r.max(min_step);
+            relaxed = false;
+            continue;
+        }
+        if (d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0) {
+            return None;
+        }
         if g < 0.0 {
-            let (mut a, mut b) = (prev, t);
+            let (mut a, mut b) = (prev_t, t);
             for _ in 0..48 {
                 let m = 0.5 * (a + b);
                 if gap(m) >= 0.0 {
@@ -155,8 +171,12 @@ pub fn march_heightfield(
             }
             return Some(a);
         }
-        prev = t;
-        t += (g / rate).max(min_step);
+        prev_t = t;
+        prev_r = r;
+        let safe = r.max(min_step);
+        let step = (RELAXATION * r).max(min_step);
+        relaxed = step > safe;
+        t += step;
     }
     None
 }

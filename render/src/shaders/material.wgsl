@@ -537,26 +537,39 @@ fn field_height(x: vec2<f32>, lod: bool, sf: f32) -> f32 {
     return surface_height(x);
 }
 
-// surface::march_heightfield: t of the first crossing, or -1 when the ray leaves the slab.
+// surface::march_heightfield (over-relaxed; backs off when the safe intervals of two points do not
+// cover the step, before concluding anything at the new point): t of the first crossing, or -1 when
+// the ray leaves the slab.
+const RELAXATION: f32 = 1.6;
+
 fn march_heightfield(o: vec3<f32>, d: vec3<f32>, rate: f32, lod: bool, sf: f32) -> f32 {
     if (!(rate > 0.0)) {
         return -1.0;
     }
     let top = params.h_max * (1.0 + 1e-6) + 1e-30;
     var t = 0.0;
-    var prev = 0.0;
+    var prev_t = 0.0;
+    var prev_r = 0.0;
+    var relaxed = false;
     for (var it = 0u; it < 20000u; it = it + 1u) {
         let p = o + d * t;
-        if ((d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0)) {
-            return -1.0;
-        }
         var gap = p.z - field_height(p.xy, lod, sf);
         if (gap < 0.0 && t == 0.0) {
             // The origin is on the surface by contract: a negative gap here is rounding.
             gap = 0.0;
         }
+        let r = max(gap, 0.0) / rate;
+        if (relaxed && t - prev_t > prev_r + r) {
+            // The relaxed step left a stretch no safe interval covers: back off and step safely.
+            t = prev_t + max(prev_r, params.min_step);
+            relaxed = false;
+            continue;
+        }
+        if ((d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0)) {
+            return -1.0;
+        }
         if (gap < 0.0) {
-            var a = prev;
+            var a = prev_t;
             var b = t;
             for (var j = 0u; j < 24u; j = j + 1u) {
                 let m = 0.5 * (a + b);
@@ -569,8 +582,12 @@ fn march_heightfield(o: vec3<f32>, d: vec3<f32>, rate: f32, lod: bool, sf: f32) 
             }
             return a;
         }
-        prev = t;
-        t = t + max(gap / rate, params.min_step);
+        prev_t = t;
+        prev_r = r;
+        let safe = max(r, params.min_step);
+        let step = max(RELAXATION * r, params.min_step);
+        relaxed = step > safe;
+        t = t + step;
     }
     return -1.0;
 }
