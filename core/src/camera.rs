@@ -53,6 +53,11 @@ impl Camera {
     /// Largest elevation the camera accepts (degrees).
     pub const MAX_ELEVATION_DEG: f64 = 89.5;
 
+    /// tan(fov/2), with the field of view clamped to (0, 120°]: the scale of the image plane.
+    pub fn tan_half_fov(&self) -> f64 {
+        (self.fov_deg.clamp(1e-3, 120.0).to_radians() * 0.5).tan()
+    }
+
     /// Unit vector from the target toward the eye.
     pub fn to_eye(&self) -> DVec3 {
         let e = self
@@ -86,7 +91,7 @@ impl Camera {
     /// +0.5) of a `width × height` image.
     fn raw_dir(&self, p: DVec2, width: u32, height: u32) -> DVec3 {
         let (r, u, f) = self.basis();
-        let t = (self.fov_deg.clamp(1e-3, 120.0).to_radians() * 0.5).tan();
+        let t = self.tan_half_fov();
         let aspect = f64::from(width) / f64::from(height.max(1));
         let nx = (p.x / f64::from(width)) * 2.0 - 1.0;
         let ny = 1.0 - (p.y / f64::from(height)) * 2.0;
@@ -111,7 +116,7 @@ impl Camera {
             return None;
         }
         let (r, u, _) = self.basis();
-        let t = (self.fov_deg.clamp(1e-3, 120.0).to_radians() * 0.5).tan();
+        let t = self.tan_half_fov();
         let aspect = f64::from(width) / f64::from(height.max(1));
         let dx = r * (2.0 * t * aspect / f64::from(width));
         let dy = u * (-2.0 * t / f64::from(height));

@@ -420,8 +420,7 @@ impl Renderer {
         params.up = v3(u);
         params.forward = v3(f);
         params.light = v3(scene.light.normalize());
-        params.tan_half_fov =
-            (scene.camera.fov_deg.clamp(1e-3, 120.0).to_radians() * 0.5).tan() as f32;
+        params.tan_half_fov = scene.camera.tan_half_fov() as f32;
         params.aspect = (f64::from(width) / f64::from(height.max(1))) as f32;
         params.pixel_sigma = PIXEL_SIGMA as f32;
         params.width = width;
