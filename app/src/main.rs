@@ -4,7 +4,9 @@
 //! 3 no GPU adapter.
 
 mod cli;
+mod editor;
 mod eval;
+mod preset_io;
 mod render_cmd;
 
 use anyhow::{Context, Result};
@@ -13,9 +15,6 @@ use cli::{Cli, Command};
 use lodestone_core::material::{Material, MaterialError};
 use std::path::Path;
 use std::process::ExitCode;
-
-/// The built-in default preset.
-const DEFAULT_PRESET: &str = include_str!("../../presets/default.ron");
 
 fn main() -> ExitCode {
     env_logger::Builder::from_env(
@@ -35,7 +34,7 @@ fn main() -> ExitCode {
 /// 2 for bad presets, 3 for a missing adapter, else 1.
 fn exit_code(e: &anyhow::Error) -> u8 {
     if e.chain()
-        .any(|c| c.is::<MaterialError>() || c.is::<PresetReadError>())
+        .any(|c| c.is::<MaterialError>() || c.is::<preset_io::PresetError>())
     {
         2
     } else if e.chain().any(|c| c.is::<lodestone_render::GpuError>()) {
@@ -45,41 +44,40 @@ fn exit_code(e: &anyhow::Error) -> u8 {
     }
 }
 
-/// A preset file that cannot be read.
-#[derive(Debug)]
-struct PresetReadError(String);
-
-impl std::fmt::Display for PresetReadError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(&self.0)
-    }
-}
-
-impl std::error::Error for PresetReadError {}
-
 /// Load a preset (or the built-in default), naming the file in any error.
 fn load(path: Option<&Path>) -> Result<Material> {
     match path {
-        None => Material::from_ron(DEFAULT_PRESET).context("built-in default preset"),
-        Some(p) => {
-            let text = std::fs::read_to_string(p)
-                .map_err(|e| PresetReadError(format!("cannot read {}: {e}", p.display())))?;
-            Material::from_ron(&text).with_context(|| format!("{}", p.display()))
-        }
+        None => Material::from_ron(preset_io::DEFAULT_PRESET).context("built-in default preset"),
+        Some(p) => Ok(preset_io::load(p)?),
     }
+}
+
+/// Open the editor window.
+fn run_editor(preset: Option<(std::path::PathBuf, Material)>) -> Result<()> {
+    let options = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("Lodestone")
+            .with_inner_size([1600.0, 900.0])
+            .with_min_inner_size([960.0, 600.0])
+            .with_drag_and_drop(true),
+        ..Default::default()
+    };
+    let opts = editor::Options {
+        preset,
+        ..editor::Options::default()
+    };
+    eframe::run_native(
+        "Lodestone",
+        options,
+        Box::new(move |cc| Ok(Box::new(editor::EditorApp::new(cc, opts)))),
+    )
+    .map_err(|e| anyhow::anyhow!("cannot open the editor window: {e}"))
 }
 
 fn run(cli: Cli) -> Result<()> {
     let material = load(cli.preset.as_deref())?;
     match cli.command {
-        None => {
-            println!(
-                "The interactive editor is not built yet (it is issue #4). Meanwhile, here is the preset \
-                 evaluated by the CPU reference; see `lodestone --help` for the headless commands.\n"
-            );
-            let r = eval::eval(&material, [60.0, 0.0, 30.0, 90.0], 20_000)?;
-            print!("{}", eval::table(&r));
-        }
+        None => run_editor(cli.preset.clone().map(|p| (p, material.clone())))?,
         Some(Command::Eval {
             view_deg,
             view_azimuth_deg,

@@ -60,14 +60,13 @@ pub fn heat_gradient() -> Gradient {
     )
 }
 
-/// Heat map of the per-pixel error (max over channels) scaled so that `scale` maps to the top of the
-/// legend (errors above it saturate), with a legend bar along the bottom (left 0, right `scale`).
-pub fn heat_map(image: &LinearImage, reference: &LinearImage, scale: f64) -> LinearImage {
+/// Heat map of the per-pixel error (max over channels), `scale` mapping to the top of the scale
+/// (errors above it saturate). Same size as the inputs, no legend (the editor draws its own).
+pub fn error_heat(image: &LinearImage, reference: &LinearImage, scale: f64) -> LinearImage {
     let g = heat_gradient();
     let scale = if scale > 0.0 { scale } else { 1.0 };
     let (w, h) = (image.width, image.height);
-    let bar = (h / 16).max(2);
-    let mut pixels = Vec::with_capacity((w * (h + bar)) as usize);
+    let mut pixels = Vec::with_capacity((w * h) as usize);
     for y in 0..h {
         for x in 0..w {
             let (a, b) = (image.rgb(x, y), reference.rgb(x, y));
@@ -78,17 +77,27 @@ pub fn heat_map(image: &LinearImage, reference: &LinearImage, scale: f64) -> Lin
             pixels.push([c[0] as f32, c[1] as f32, c[2] as f32, 1.0]);
         }
     }
+    LinearImage {
+        width: w,
+        height: h,
+        pixels,
+    }
+}
+
+/// [`error_heat`] with a legend bar along the bottom (left 0, right `scale`).
+pub fn heat_map(image: &LinearImage, reference: &LinearImage, scale: f64) -> LinearImage {
+    let g = heat_gradient();
+    let mut out = error_heat(image, reference, scale);
+    let (w, h) = (out.width, out.height);
+    let bar = (h / 16).max(2);
     for _ in 0..bar {
         for x in 0..w {
             let c = g.sample(f64::from(x) / f64::from(w.max(2) - 1));
-            pixels.push([c[0] as f32, c[1] as f32, c[2] as f32, 1.0]);
+            out.pixels.push([c[0] as f32, c[1] as f32, c[2] as f32, 1.0]);
         }
     }
-    LinearImage {
-        width: w,
-        height: h + bar,
-        pixels,
-    }
+    out.height = h + bar;
+    out
 }
 
 #[cfg(test)]

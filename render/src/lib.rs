@@ -1,8 +1,9 @@
 //! # lodestone-render
 //!
-//! Lodestone's renderer on wgpu, with no UI. It grows into one render target per view (naive MIP,
-//! ground truth, filtered) with offscreen readback; today it holds device setup, the WGSL mirrors of
-//! `lodestone-core`'s f32 functions and the harness that checks them on the adapter.
+//! Lodestone's renderer on wgpu, with no UI: headless device setup, the WGSL mirrors of
+//! `lodestone-core`'s f32 functions (and the harness that checks them on the adapter), one
+//! accumulation target per view (naive MIP, view-independent, filtered, ground truth) with readback
+//! to linear f32 and 8-bit sRGB, and error heat maps.
 
 pub mod compute;
 pub mod error_map;

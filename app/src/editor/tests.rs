@@ -1,0 +1,183 @@
+//! The editor driven through egui_kittest on the real wgpu renderer: load a preset, move sliders,
+//! drag a colour stop, undo and redo, toggle the error view, and snapshot the window.
+
+use super::worker::DeviceSource;
+use super::*;
+use egui_kittest::kittest::Queryable;
+use egui_kittest::{Harness, SnapshotOptions};
+use std::time::{Duration, Instant};
+
+fn preset(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../presets")
+        .join(name)
+}
+
+fn harness(w: f32, h: f32, device: DeviceSource) -> Harness<'static, EditorApp> {
+    Harness::builder()
+        .with_size(egui::vec2(w, h))
+        .wgpu()
+        .build_eframe(move |cc| {
+            let mut app = EditorApp::new(
+                cc,
+                Options {
+                    preset: None,
+                    device,
+                    persist: false,
+                },
+            );
+            // Small, quick, deterministic views for tests.
+            app.view.max_scale = 0.25;
+            app.view.truth_spp = 4;
+            app.deterministic = true;
+            app
+        })
+}
+
+/// Step the harness until the views and plots are finished (or `timeout`).
+fn settle(h: &mut Harness<'static, EditorApp>, timeout: Duration) {
+    let t0 = Instant::now();
+    h.step();
+    while t0.elapsed() < timeout {
+        h.step();
+        if h.state().idle() {
+            // One more frame so the last images are on screen.
+            h.step();
+            h.step();
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    panic!("the editor did not settle in {timeout:?}");
+}
+
+fn no_adapter(h: &Harness<'static, EditorApp>) -> bool {
+    matches!(h.state().device, DeviceStatus::Failed(_))
+}
+
+#[test]
+fn loads_a_preset_and_edits_undo_redo() {
+    let mut h = harness(1600.0, 900.0, DeviceSource::Headless);
+    h.step();
+    let ctx = h.ctx.clone();
+    h.state_mut().open_path(&ctx, &preset("moss.ron"));
+    h.step();
+    assert_eq!(h.state().material().name, "Moss clumps (transfer function)");
+    assert!(!h.state().dirty());
+
+    // Move σ_h with the slider.
+    let before = h.state().material().heights.sigma_h;
+    h.get_by_role_and_label(egui::accesskit::Role::Slider, "σ_h").set_value_accesskit(0.25);
+    h.step();
+    h.step();
+    let after = h.state().material().heights.sigma_h;
+    assert!((after - 0.25).abs() < 1e-9, "σ_h = {after}");
+    assert!(h.state().dirty());
+
+    // Undo and redo with the keyboard.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.step();
+    assert_eq!(h.state().material().heights.sigma_h, before);
+    h.key_press_modifiers(Modifiers::COMMAND | Modifiers::SHIFT, Key::Z);
+    h.step();
+    assert_eq!(h.state().material().heights.sigma_h, after);
+
+    // A bad preset changes nothing and says why.
+    let bad = std::env::temp_dir().join(format!("lodestone-bad-{}.ron", std::process::id()));
+    std::fs::write(&bad, "(version: 1, name: 3").expect("write");
+    let m = h.state().material().clone();
+    h.state_mut().open_path(&ctx, &bad);
+    h.step();
+    assert_eq!(*h.state().material(), m);
+    let notice = h.state().notice.clone().expect("a notice");
+    assert!(notice.error && notice.text.contains("line 1"), "{}", notice.text);
+}
+
+#[test]
+fn dragging_a_colour_stop_moves_it_and_undoes_in_one_step() {
+    let mut h = harness(1600.0, 900.0, DeviceSource::Headless);
+    h.step();
+    let stops = |h: &Harness<'static, EditorApp>| match &h.state().material().color {
+        lodestone_core::material::ColorModel::Gradient { map, .. } => {
+            map.stops.iter().map(|s| s.position).collect::<Vec<_>>()
+        }
+        _ => panic!("the default preset has a colour map"),
+    };
+    let before = stops(&h);
+    let r = h.get_by_label("Colour stop 2").rect();
+    let start = r.center();
+    h.hover_at(start);
+    h.step();
+    h.drag_at(start);
+    h.step();
+    for k in 1..=5 {
+        h.hover_at(start + egui::vec2(6.0 * k as f32, 0.0));
+        h.step();
+    }
+    h.drop_at(start + egui::vec2(30.0, 0.0));
+    h.step();
+    h.step();
+    let after = stops(&h);
+    assert_eq!(before.len(), after.len());
+    assert!(after[1] > before[1], "{before:?} → {after:?}");
+    // The whole drag is one undo step.
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.step();
+    assert_eq!(stops(&h), before);
+}
+
+#[test]
+fn error_view_toggles_and_window_snapshots() {
+    let mut h = harness(1600.0, 900.0, DeviceSource::Headless);
+    h.step();
+    if no_adapter(&h) {
+        eprintln!("skipped: no adapter");
+        return;
+    }
+    h.state_mut().view.camera.elevation_deg = 78.0;
+    h.get_by_label("Error maps").click();
+    h.step();
+    assert!(h.state().view.show_error);
+    settle(&mut h, Duration::from_secs(240));
+    let e = h.state().errors.get(&ViewMode::Naive).expect("naive error map");
+    let f = h.state().errors.get(&ViewMode::Filtered).expect("filtered error map");
+    assert!(e.stats.rmse.is_finite() && f.stats.rmse.is_finite());
+    h.snapshot_options(
+        "editor_grazing_errors",
+        &SnapshotOptions::new().threshold(2.0).max_failed_pixels(4000),
+    );
+    h.get_by_label("Error maps").click();
+    h.step();
+    assert!(!h.state().view.show_error);
+}
+
+#[test]
+fn default_window_snapshot_at_1280x720() {
+    let mut h = harness(1280.0, 720.0, DeviceSource::Headless);
+    h.step();
+    if no_adapter(&h) {
+        eprintln!("skipped: no adapter");
+        return;
+    }
+    settle(&mut h, Duration::from_secs(240));
+    h.snapshot_options(
+        "editor_default_1280x720",
+        &SnapshotOptions::new().threshold(2.0).max_failed_pixels(4000),
+    );
+}
+
+#[test]
+fn without_an_adapter_the_window_still_opens_and_says_why() {
+    let mut h = harness(1280.0, 720.0, DeviceSource::Unavailable);
+    let t0 = Instant::now();
+    while !no_adapter(&h) && t0.elapsed() < Duration::from_secs(10) {
+        h.step();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    h.step();
+    assert!(no_adapter(&h));
+    // Editing still works.
+    h.get_by_role_and_label(egui::accesskit::Role::Slider, "σ_h").set_value_accesskit(0.2);
+    h.step();
+    assert!((h.state().material().heights.sigma_h - 0.2).abs() < 1e-9);
+}

@@ -1,0 +1,432 @@
+//! The render worker: a thread that owns its own headless GPU device and renders the views the
+//! editor asks for, so the window stays responsive however slow the adapter is (Mesa's llvmpipe
+//! takes seconds for a full-resolution ray-marched frame).
+//!
+//! Every request carries the whole state (material, scene, view size, modes). The worker always
+//! serves the newest request: older ones are dropped unread. For a request it
+//! 1. prepares the material (tables are rebuilt only when the material changed),
+//! 2. renders the analytic modes at a resolution chosen so a pass fits a time budget, then
+//!    doubles the resolution pass by pass up to the full view size (progressive refinement),
+//! 3. accumulates ground truth one ray per pixel per frame at the final resolution until the
+//!    requested samples per pixel are reached,
+//!
+//! checking for a newer request between passes.
+
+use lodestone_core::footprint::Prepared;
+use lodestone_core::material::Material;
+use lodestone_render::{GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget};
+use std::sync::Arc;
+use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, TryRecvError};
+use std::time::{Duration, Instant};
+
+/// What the editor wants drawn.
+#[derive(Clone, Debug)]
+pub struct Request {
+    /// Increases with every change the views must follow.
+    pub generation: u64,
+    /// The material.
+    pub material: Arc<Material>,
+    /// Camera and light.
+    pub scene: Scene,
+    /// Full size of one view in physical pixels.
+    pub size: [u32; 2],
+    /// Modes to render (each at most once).
+    pub modes: Vec<ViewMode>,
+    /// Ground-truth rays per pixel to accumulate.
+    pub truth_spp: u32,
+    /// Largest fraction of the full size to render (1 = full resolution).
+    pub max_scale: f32,
+}
+
+/// A finished image of one mode.
+#[derive(Clone, Debug)]
+pub struct Frame {
+    /// The request it answers.
+    pub generation: u64,
+    /// Its mode.
+    pub mode: ViewMode,
+    /// Linear RGB (divided by the weight on read).
+    pub image: Arc<LinearImage>,
+    /// Ground-truth rays per pixel in it (0 for analytic modes).
+    pub samples: u32,
+    /// GPU time of the pass that produced it (for truth: of the last ray per pixel).
+    pub pass_time: Duration,
+    /// Resolution as a fraction of the full view size.
+    pub scale: f32,
+}
+
+/// Messages from the worker.
+#[derive(Debug)]
+pub enum Event {
+    /// The device is up.
+    Ready {
+        /// "name (backend, type)".
+        adapter: String,
+    },
+    /// No device: nothing will be drawn.
+    NoAdapter(String),
+    /// The material cannot be prepared (e.g. an image driver file is missing).
+    MaterialError(String),
+    /// A new image.
+    Frame(Frame),
+    /// Rendering failed.
+    RenderError(String),
+}
+
+/// Handle on the worker thread.
+#[derive(Debug)]
+pub struct Worker {
+    requests: Sender<Request>,
+    events: Receiver<Event>,
+}
+
+/// Where the worker's device comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DeviceSource {
+    /// The best headless adapter.
+    Headless,
+    /// None: the no-adapter path (tests, or `LODESTONE_NO_GPU=1`).
+    Unavailable,
+}
+
+/// Target duration of one analytic pass when picking the first resolution.
+const PASS_BUDGET: Duration = Duration::from_millis(60);
+/// Smallest resolution scale.
+const MIN_SCALE: f32 = 1.0 / 16.0;
+
+impl Worker {
+    /// Start the worker. `repaint` is called after every event (wakes the UI).
+    pub fn spawn(source: DeviceSource, repaint: impl Fn() + Send + 'static) -> Self {
+        let (req_tx, req_rx) = std::sync::mpsc::channel::<Request>();
+        let (ev_tx, ev_rx) = std::sync::mpsc::channel::<Event>();
+        let spawned = std::thread::Builder::new()
+            .name("lodestone-render".into())
+            .spawn(move || {
+                let send = |e: Event| {
+                    let _ = ev_tx.send(e);
+                    repaint();
+                };
+                let ctx = match source {
+                    DeviceSource::Headless => GpuContext::new_headless().map_err(|e| e.to_string()),
+                    DeviceSource::Unavailable => {
+                        Err("no GPU adapter (disabled for this session)".to_string())
+                    }
+                };
+                match ctx {
+                    Ok(ctx) => {
+                        send(Event::Ready {
+                            adapter: ctx.describe(),
+                        });
+                        State::new(Renderer::new(ctx)).run(&req_rx, &send);
+                    }
+                    Err(e) => send(Event::NoAdapter(e)),
+                }
+            });
+        if let Err(e) = spawned {
+            log::error!("cannot start the render thread: {e}");
+        }
+        Self {
+            requests: req_tx,
+            events: ev_rx,
+        }
+    }
+
+    /// Ask for a new set of views (replaces any pending request).
+    pub fn request(&self, r: Request) {
+        let _ = self.requests.send(r);
+    }
+
+    /// Events that arrived since the last call.
+    pub fn poll(&self) -> Vec<Event> {
+        self.events.try_iter().collect()
+    }
+
+    /// Wait up to `timeout` for the next event (tests).
+    #[cfg(test)]
+    pub fn wait(&self, timeout: Duration) -> Option<Event> {
+        self.events.recv_timeout(timeout).ok()
+    }
+}
+
+/// The worker's state between requests.
+struct State {
+    renderer: Renderer,
+    material: Option<(Arc<Material>, GpuMaterial)>,
+    /// Seconds per pixel of each analytic mode, measured.
+    cost: Vec<(ViewMode, f64)>,
+    truth: Option<ViewTarget>,
+}
+
+impl State {
+    fn new(renderer: Renderer) -> Self {
+        Self {
+            renderer,
+            material: None,
+            cost: Vec::new(),
+            truth: None,
+        }
+    }
+
+    /// Newest request waiting, if any (drains the queue). `Err` when the editor is gone.
+    fn newest(rx: &Receiver<Request>) -> Result<Option<Request>, ()> {
+        let mut last = None;
+        loop {
+            match rx.try_recv() {
+                Ok(r) => last = Some(r),
+                Err(TryRecvError::Empty) => return Ok(last),
+                Err(TryRecvError::Disconnected) => return Err(()),
+            }
+        }
+    }
+
+    fn run(mut self, rx: &Receiver<Request>, send: &dyn Fn(Event)) {
+        let mut pending: Option<Request> = None;
+        loop {
+            let req = match pending.take() {
+                Some(r) => r,
+                None => match rx.recv_timeout(Duration::from_secs(3600)) {
+                    Ok(r) => r,
+                    Err(RecvTimeoutError::Timeout) => continue,
+                    Err(RecvTimeoutError::Disconnected) => return,
+                },
+            };
+            let req = match Self::newest(rx) {
+                Ok(Some(newer)) => newer,
+                Ok(None) => req,
+                Err(()) => return,
+            };
+            match self.serve(&req, rx, send) {
+                Ok(next) => pending = next,
+                Err(()) => return,
+            }
+        }
+    }
+
+    fn upload(&mut self, material: &Arc<Material>, send: &dyn Fn(Event)) -> bool {
+        if let Some((m, _)) = &self.material
+            && (Arc::ptr_eq(m, material) || **m == **material)
+        {
+            return true;
+        }
+        match Prepared::new(material) {
+            Ok(p) => {
+                let gm = GpuMaterial::new(self.renderer.context(), &p, [0.0, 0.0]);
+                self.material = Some((material.clone(), gm));
+                true
+            }
+            Err(e) => {
+                self.material = None;
+                send(Event::MaterialError(e.to_string()));
+                false
+            }
+        }
+    }
+
+    fn cost_of(&self, mode: ViewMode) -> Option<f64> {
+        self.cost.iter().find(|(m, _)| *m == mode).map(|(_, c)| *c)
+    }
+
+    fn set_cost(&mut self, mode: ViewMode, per_pixel: f64) {
+        match self.cost.iter_mut().find(|(m, _)| *m == mode) {
+            Some(c) => c.1 = per_pixel,
+            None => self.cost.push((mode, per_pixel)),
+        }
+    }
+
+    /// First scale: the largest power-of-two fraction whose analytic passes fit the budget.
+    fn first_scale(&self, req: &Request) -> f32 {
+        let full = f64::from(req.size[0]) * f64::from(req.size[1]);
+        let per_pixel: f64 = req
+            .modes
+            .iter()
+            .filter(|m| **m != ViewMode::Truth)
+            .map(|m| self.cost_of(*m).unwrap_or(2e-6))
+            .sum::<f64>()
+            .max(1e-12);
+        let mut s = req.max_scale.clamp(MIN_SCALE, 1.0);
+        while s > MIN_SCALE && full * f64::from(s * s) * per_pixel > PASS_BUDGET.as_secs_f64() {
+            s *= 0.5;
+        }
+        s
+    }
+
+    fn size_at(req: &Request, scale: f32) -> (u32, u32) {
+        let f = |v: u32| ((v as f32 * scale).round() as u32).max(1);
+        (f(req.size[0]), f(req.size[1]))
+    }
+
+    /// Serve one request until done or superseded. Returns the superseding request, if any;
+    /// `Err` when the editor has gone.
+    fn serve(
+        &mut self,
+        req: &Request,
+        rx: &Receiver<Request>,
+        send: &dyn Fn(Event),
+    ) -> Result<Option<Request>, ()> {
+        if !self.upload(&req.material, send) {
+            return Ok(None);
+        }
+        let max_scale = req.max_scale.clamp(MIN_SCALE, 1.0);
+        let mut scale = self.first_scale(req);
+        loop {
+            let size = Self::size_at(req, scale);
+            for &mode in req.modes.iter().filter(|m| **m != ViewMode::Truth) {
+                let Some((_, gm)) = &self.material else {
+                    return Ok(None);
+                };
+                let t0 = Instant::now();
+                let img = self.renderer.render(gm, &req.scene, mode, size, 1);
+                let dt = t0.elapsed();
+                match img {
+                    Ok(image) => {
+                        self.set_cost(mode, dt.as_secs_f64() / f64::from(size.0 * size.1));
+                        send(Event::Frame(Frame {
+                            generation: req.generation,
+                            mode,
+                            image: Arc::new(image),
+                            samples: 0,
+                            pass_time: dt,
+                            scale,
+                        }));
+                    }
+                    Err(e) => {
+                        send(Event::RenderError(e.to_string()));
+                        return Ok(None);
+                    }
+                }
+                if let Some(newer) = Self::newest(rx)? {
+                    return Ok(Some(newer));
+                }
+            }
+            if scale >= max_scale {
+                break;
+            }
+            scale = (scale * 2.0).min(max_scale);
+        }
+        if !req.modes.contains(&ViewMode::Truth) || req.truth_spp == 0 {
+            return Ok(None);
+        }
+        self.accumulate_truth(req, scale, rx, send)
+    }
+
+    fn accumulate_truth(
+        &mut self,
+        req: &Request,
+        scale: f32,
+        rx: &Receiver<Request>,
+        send: &dyn Fn(Event),
+    ) -> Result<Option<Request>, ()> {
+        let size = Self::size_at(req, scale);
+        let mut target = match self.truth.take() {
+            Some(t) if t.size() == size => t,
+            _ => ViewTarget::new(&self.renderer, size.0, size.1),
+        };
+        target.reset();
+        let mut last_sent = Instant::now() - Duration::from_secs(1);
+        let result = loop {
+            let Some((_, gm)) = &self.material else {
+                break Ok(None);
+            };
+            let t0 = Instant::now();
+            self.renderer
+                .draw(&mut target, gm, &req.scene, ViewMode::Truth, 1);
+            self.renderer.wait();
+            let dt = t0.elapsed();
+            let done = target.samples >= req.truth_spp;
+            // Read back at most ~8 times a second (and always at the end): readback costs a copy.
+            if done || last_sent.elapsed() > Duration::from_millis(120) || target.samples <= 4 {
+                match target.read(&self.renderer) {
+                    Ok(image) => send(Event::Frame(Frame {
+                        generation: req.generation,
+                        mode: ViewMode::Truth,
+                        image: Arc::new(image),
+                        samples: target.samples,
+                        pass_time: dt,
+                        scale,
+                    })),
+                    Err(e) => {
+                        send(Event::RenderError(e.to_string()));
+                        break Ok(None);
+                    }
+                }
+                last_sent = Instant::now();
+            }
+            match Self::newest(rx) {
+                Err(()) => break Err(()),
+                Ok(Some(newer)) => break Ok(Some(newer)),
+                Ok(None) if done => break Ok(None),
+                Ok(None) => {}
+            }
+        };
+        self.truth = Some(target);
+        result
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lodestone_core::camera::Camera;
+    use lodestone_core::smith::direction;
+
+    fn request(generation: u64, spp: u32) -> Request {
+        Request {
+            generation,
+            material: Arc::new(Material::default()),
+            scene: Scene {
+                camera: Camera::default(),
+                light: direction(0.5, 1.0),
+            },
+            size: [32, 24],
+            modes: vec![ViewMode::Naive, ViewMode::Filtered, ViewMode::Truth],
+            truth_spp: spp,
+            max_scale: 1.0,
+        }
+    }
+
+    /// The worker renders every requested mode, refines to full size, and accumulates exactly
+    /// the requested truth samples.
+    #[test]
+    fn serves_every_mode_up_to_full_resolution() {
+        let w = Worker::spawn(DeviceSource::Headless, || {});
+        match w.wait(Duration::from_secs(60)) {
+            Some(Event::Ready { .. }) => {}
+            Some(Event::NoAdapter(e)) => {
+                eprintln!("skipped: {e}");
+                return;
+            }
+            other => panic!("unexpected {other:?}"),
+        }
+        w.request(request(7, 3));
+        let mut full = Vec::new();
+        let mut truth_spp = 0;
+        while let Some(ev) = w.wait(Duration::from_secs(120)) {
+            let Event::Frame(f) = ev else {
+                panic!("unexpected {ev:?}")
+            };
+            assert_eq!(f.generation, 7);
+            assert!(f.image.pixels.iter().flatten().all(|v| v.is_finite()));
+            if f.scale == 1.0 {
+                assert_eq!((f.image.width, f.image.height), (32, 24));
+                full.push(f.mode);
+            }
+            if f.mode == ViewMode::Truth {
+                truth_spp = f.samples;
+                if f.samples == 3 {
+                    break;
+                }
+            }
+        }
+        assert!(full.contains(&ViewMode::Naive) && full.contains(&ViewMode::Filtered));
+        assert_eq!(truth_spp, 3);
+    }
+
+    #[test]
+    fn reports_a_missing_adapter() {
+        let w = Worker::spawn(DeviceSource::Unavailable, || {});
+        assert!(matches!(
+            w.wait(Duration::from_secs(10)),
+            Some(Event::NoAdapter(_))
+        ));
+    }
+}
