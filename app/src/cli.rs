@@ -64,6 +64,12 @@ pub enum Command {
         /// Image size, WxH.
         #[arg(long, default_value = "512x384", value_parser = parse_size)]
         size: (u32, u32),
+        /// The object: the plane, or a cylinder whose top line passes through the camera target.
+        #[arg(long, value_enum, default_value_t = ShapeArg::Plane)]
+        shape: ShapeArg,
+        /// Radius of the cylinder (world units).
+        #[arg(long, default_value_t = 2.0)]
+        radius: f64,
         /// Ground-truth rays per pixel.
         #[arg(long, default_value_t = 64)]
         spp: u32,
@@ -110,6 +116,15 @@ pub enum RenderMode {
     Error,
     /// Every mode and every error map, into a directory.
     All,
+}
+
+/// The object `render` draws.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ShapeArg {
+    /// The unbounded plane.
+    Plane,
+    /// A cylinder around an axis parallel to x.
+    Cylinder,
 }
 
 /// Parse "WxH".

@@ -105,16 +105,28 @@ fn run(cli: Cli) -> Result<()> {
             light_azimuth_deg,
             distance,
             size,
+            shape,
+            radius,
             spp,
             out,
             formats,
         }) => {
+            let shape = match shape {
+                cli::ShapeArg::Plane => lodestone_core::cylinder::Shape::Plane,
+                cli::ShapeArg::Cylinder => {
+                    if !(radius > 0.0 && radius.is_finite()) {
+                        anyhow::bail!("--radius must be a positive number, got {radius}");
+                    }
+                    lodestone_core::cylinder::Shape::Cylinder { radius }
+                }
+            };
             let view = render_cmd::View {
                 view_deg,
                 view_azimuth_deg,
                 light_deg,
                 light_azimuth_deg,
                 distance,
+                shape,
             };
             render_cmd::render(&material, view, mode, size, spp, &out, formats)?;
         }

@@ -3,6 +3,7 @@
 use crate::cli::{Formats, RenderMode};
 use anyhow::{Context, Result, bail};
 use lodestone_core::camera::Camera;
+use lodestone_core::cylinder::Shape;
 use lodestone_core::footprint::Prepared;
 use lodestone_core::material::Material;
 use lodestone_core::smith::direction;
@@ -26,6 +27,8 @@ pub struct View {
     pub light_azimuth_deg: f64,
     /// Camera distance.
     pub distance: f64,
+    /// The object.
+    pub shape: Shape,
 }
 
 impl View {
@@ -41,7 +44,11 @@ impl View {
             self.light_deg.clamp(0.0, 90.0).to_radians(),
             self.light_azimuth_deg.to_radians(),
         );
-        Scene { camera, light }
+        Scene {
+            camera,
+            light,
+            shape: self.shape,
+        }
     }
 }
 
@@ -159,6 +166,7 @@ pub fn bench(material: &Material, size: (u32, u32), frames: u32, json: bool) -> 
         light_deg: 30.0,
         light_azimuth_deg: 90.0,
         distance: 6.0,
+        shape: Shape::Plane,
     }
     .scene();
     let gm = GpuMaterial::new(r.context(), &prepared, scene.camera.target);

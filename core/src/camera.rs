@@ -89,13 +89,24 @@ impl Camera {
 
     /// Unnormalised direction through continuous pixel coordinates (x right, y down, pixel centres at
     /// +0.5) of a `width × height` image.
-    fn raw_dir(&self, p: DVec2, width: u32, height: u32) -> DVec3 {
+    pub(crate) fn raw_dir(&self, p: DVec2, width: u32, height: u32) -> DVec3 {
         let (r, u, f) = self.basis();
         let t = self.tan_half_fov();
         let aspect = f64::from(width) / f64::from(height.max(1));
         let nx = (p.x / f64::from(width)) * 2.0 - 1.0;
         let ny = 1.0 - (p.y / f64::from(height)) * 2.0;
         f + r * (nx * t * aspect) + u * (ny * t)
+    }
+
+    /// Change of the unnormalised ray direction per pixel in x and in y.
+    pub(crate) fn pixel_steps(&self, width: u32, height: u32) -> (DVec3, DVec3) {
+        let (r, u, _) = self.basis();
+        let t = self.tan_half_fov();
+        let aspect = f64::from(width) / f64::from(height.max(1));
+        (
+            r * (2.0 * t * aspect / f64::from(width)),
+            u * (-2.0 * t / f64::from(height)),
+        )
     }
 
     /// The ray through continuous pixel coordinates `p`.
@@ -115,11 +126,7 @@ impl Camera {
         if !(d.z < 0.0) {
             return None;
         }
-        let (r, u, _) = self.basis();
-        let t = self.tan_half_fov();
-        let aspect = f64::from(width) / f64::from(height.max(1));
-        let dx = r * (2.0 * t * aspect / f64::from(width));
-        let dy = u * (-2.0 * t / f64::from(height));
+        let (dx, dy) = self.pixel_steps(width, height);
         // x(p) = e − e_z/d_z · d  ⇒  ∂x = −e_z (∂d·d_z − d·∂d_z)/d_z².
         let hit = e - d * (e.z / d.z);
         let jac = |dd: DVec3| -(dd * d.z - d * dd.z) * (e.z / (d.z * d.z));

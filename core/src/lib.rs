@@ -12,6 +12,7 @@ pub mod attribute;
 pub mod brdf;
 pub mod camera;
 pub mod colormap;
+pub mod cylinder;
 pub mod effective_height;
 pub mod footprint;
 pub mod image_driver;

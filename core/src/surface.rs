@@ -84,6 +84,17 @@ impl Surface {
         self.sigma_h * self.g_lip * self.noise.lipschitz_along(dir)
     }
 
+    /// A bound of |∇h| in every direction: σ_h·max|g′|·Σ|a_i|·2π|k_i|.
+    pub fn slope_bound(&self) -> f64 {
+        let n: f64 = self
+            .noise
+            .waves
+            .iter()
+            .map(|w| w.amplitude.abs() * std::f64::consts::TAU * w.k.length())
+            .sum();
+        self.sigma_h * self.g_lip * n
+    }
+
     /// March `p(t) = o + t·d` (d unit) from t = 0 while it is above the surface; `Hit(t)` at the first
     /// crossing. `o` must be on or above the surface; a negative gap at `o` itself is taken as rounding
     /// (a shadow ray leaving a hit point), never as a crossing.

@@ -93,7 +93,8 @@ pub fn heat_map(image: &LinearImage, reference: &LinearImage, scale: f64) -> Lin
     for _ in 0..bar {
         for x in 0..w {
             let c = g.sample(f64::from(x) / f64::from(w.max(2) - 1));
-            out.pixels.push([c[0] as f32, c[1] as f32, c[2] as f32, 1.0]);
+            out.pixels
+                .push([c[0] as f32, c[1] as f32, c[2] as f32, 1.0]);
         }
     }
     out.height = h + bar;

@@ -61,6 +61,11 @@ impl GpuContext {
         })
     }
 
+    /// Whether the adapter is a software rasterizer (Mesa's llvmpipe or lavapipe, WARP, …).
+    pub fn is_software(&self) -> bool {
+        self.info.device_type == wgpu::DeviceType::Cpu
+    }
+
     /// "name (backend, device type)".
     pub fn describe(&self) -> String {
         format!(

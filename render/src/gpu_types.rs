@@ -24,7 +24,7 @@ pub struct GpuParams {
     pub dh_ln_max: f32,
     pub width: u32,
     pub height: u32,
-    pub reserved: u32,
+    pub shape: u32,
     pub wave_count: u32,
     pub sigma_h: f32,
     pub albedo: f32,
@@ -60,8 +60,8 @@ pub struct GpuParams {
     pub tp_knots: u32,
     pub waves_offset: u32,
     pub dh_offset: u32,
-    pub pad0: u32,
-    pub pad1: u32,
+    pub radius: f32,
+    pub slope_bound: f32,
 }
 
 /// Field names and byte offsets of [`GpuParams`], in declaration order (for the layout test).
@@ -86,7 +86,7 @@ pub fn gpu_params_offsets() -> Vec<(&'static str, usize)> {
         dh_ln_max,
         width,
         height,
-        reserved,
+        shape,
         wave_count,
         sigma_h,
         albedo,
@@ -122,7 +122,7 @@ pub fn gpu_params_offsets() -> Vec<(&'static str, usize)> {
         tp_knots,
         waves_offset,
         dh_offset,
-        pad0,
-        pad1
+        radius,
+        slope_bound
     )
 }

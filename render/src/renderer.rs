@@ -7,6 +7,7 @@ use crate::shaders;
 use glam::DVec3;
 use lodestone_core::camera::{Camera, PIXEL_SIGMA};
 use lodestone_core::colormap::linear_to_srgb;
+use lodestone_core::cylinder::Shape;
 use lodestone_core::effective_height::{EffectiveHeightTable, HeightFilter};
 use lodestone_core::footprint::{Prepared, hermite_rule};
 use lodestone_core::material::{ColorModel, ColorSource};
@@ -48,13 +49,15 @@ impl ViewMode {
     }
 }
 
-/// Camera and light.
+/// Camera, light and object.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Scene {
     /// The camera.
     pub camera: Camera,
     /// Unit direction toward the light.
     pub light: DVec3,
+    /// The object: the plane, or a cylinder.
+    pub shape: Shape,
 }
 
 /// A linear-RGB image; `pixels[i][3]` is the sample count (1 for the analytic views).
@@ -216,7 +219,13 @@ pub struct Renderer {
 
 /// The WGSL the view pass compiles: special functions, material model, view entry point.
 pub fn view_source() -> String {
-    [shaders::SPECIAL, shaders::MATERIAL, shaders::VIEW].join("\n")
+    [
+        shaders::SPECIAL,
+        shaders::MATERIAL,
+        shaders::CYLINDER,
+        shaders::VIEW,
+    ]
+    .join("\n")
 }
 
 fn push_table(data: &mut Vec<f32>, t: &PreconvolvedTable) -> u32 {
@@ -329,6 +338,7 @@ impl GpuMaterial {
         base.h_max = s.h_max as f32;
         base.g_lip = s.g_lip as f32;
         base.min_step = s.min_step as f32;
+        base.slope_bound = s.slope_bound() as f32;
         base.correlation = u32::from(m.filtering.correlation == Correlation::HeightDirection);
         base.height_filter = u32::from(m.filtering.height_filter == HeightFilter::PaperFit);
         base.g_mean = prepared.g_global.0 as f32;
@@ -426,6 +436,13 @@ impl Renderer {
         params.width = width;
         params.height = height;
         params.mode = mode.code();
+        match scene.shape {
+            Shape::Plane => params.shape = 0,
+            Shape::Cylinder { radius } => {
+                params.shape = 1;
+                params.radius = radius as f32;
+            }
+        }
         let bind = self
             .ctx
             .device

@@ -6,6 +6,9 @@ pub const SPECIAL: &str = include_str!("shaders/special.wgsl");
 /// The material model (mirrors of core's noise, transfer, tables, Smith, BRDF and footprint code).
 pub const MATERIAL: &str = include_str!("shaders/material.wgsl");
 
+/// The curved object (mirrors `lodestone_core::cylinder`).
+pub const CYLINDER: &str = include_str!("shaders/cylinder.wgsl");
+
 /// The view pass (camera rays, footprints, modes, progressive ground truth).
 pub const VIEW: &str = include_str!("shaders/view.wgsl");
 
@@ -13,6 +16,7 @@ pub const VIEW: &str = include_str!("shaders/view.wgsl");
 pub const ALL: &[(&str, &str)] = &[
     ("special.wgsl", SPECIAL),
     ("material.wgsl", MATERIAL),
+    ("cylinder.wgsl", CYLINDER),
     ("view.wgsl", VIEW),
 ];
 
@@ -20,7 +24,8 @@ pub const ALL: &[(&str, &str)] = &[
 pub fn prelude_for(name: &str) -> Vec<&'static str> {
     match name {
         "material.wgsl" => vec![SPECIAL],
-        "view.wgsl" => vec![SPECIAL, MATERIAL],
+        "cylinder.wgsl" => vec![SPECIAL, MATERIAL],
+        "view.wgsl" => vec![SPECIAL, MATERIAL, CYLINDER],
         _ => vec![],
     }
 }

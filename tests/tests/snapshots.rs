@@ -4,6 +4,7 @@
 
 use glam::DVec3;
 use lodestone_core::camera::Camera;
+use lodestone_core::cylinder::Shape;
 use lodestone_core::footprint::Prepared;
 use lodestone_core::material::Material;
 use lodestone_core::smith::direction;
@@ -75,9 +76,23 @@ fn views_match_their_snapshots() {
     };
     eprintln!("snapshots on {}", ctx.describe());
     let r = Renderer::new(ctx);
+    let plane = Shape::Plane;
+    let cylinder = Shape::Cylinder { radius: 1.2 };
     let views = [
         (
+            "cylinder",
+            cylinder,
+            Camera {
+                elevation_deg: 65.0,
+                azimuth_deg: 80.0,
+                distance: 5.0,
+                target: [0.0, 0.0],
+                fov_deg: 40.0,
+            },
+        ),
+        (
             "near",
+            plane,
             Camera {
                 elevation_deg: 45.0,
                 azimuth_deg: 15.0,
@@ -88,6 +103,7 @@ fn views_match_their_snapshots() {
         ),
         (
             "grazing",
+            plane,
             Camera {
                 elevation_deg: 84.0,
                 azimuth_deg: -30.0,
@@ -98,6 +114,7 @@ fn views_match_their_snapshots() {
         ),
         (
             "far",
+            plane,
             Camera {
                 elevation_deg: 60.0,
                 azimuth_deg: 120.0,
@@ -113,8 +130,15 @@ fn views_match_their_snapshots() {
         let text = std::fs::read_to_string(root().join("../presets").join(format!("{preset}.ron")))
             .unwrap();
         let prepared = Prepared::new(&Material::from_ron(&text).unwrap()).unwrap();
-        for (view, camera) in views {
-            let scene = Scene { camera, light };
+        for (view, shape, camera) in views {
+            if shape != plane && preset != "default" {
+                continue;
+            }
+            let scene = Scene {
+                camera,
+                light,
+                shape,
+            };
             let gm = GpuMaterial::new(r.context(), &prepared, camera.target);
             for (mode_name, mode) in [
                 ("naive", ViewMode::Naive),

@@ -2,7 +2,7 @@
 //! space to add a point, right-click a point to remove it), named shapes, and a live histogram of
 //! the resulting heights h = g(f), f ~ N(0, 1) [HNPN14 Sec. 7].
 
-use egui::{Color32, Pos2, Rect, Sense, Stroke, Ui, Vec2, Role, WidgetInfo};
+use egui::{Color32, Pos2, Rect, Role, Sense, Stroke, Ui, Vec2, WidgetInfo};
 use lodestone_core::transfer::{Curve, CurveInterpolation, TransferFunction};
 
 /// Persistent UI state (the selected point).
@@ -63,7 +63,11 @@ impl CurveEditor {
         let mut changed = false;
         ui.horizontal_wrapped(|ui| {
             let shapes: [(&str, &str, TransferFunction); 5] = [
-                ("Identity", "g(f) = f: Gaussian heights", TransferFunction::Identity),
+                (
+                    "Identity",
+                    "g(f) = f: Gaussian heights",
+                    TransferFunction::Identity,
+                ),
                 (
                     "Moss",
                     "A flat floor with rounded clumps where the driver is high",
@@ -304,7 +308,11 @@ fn sample_range(t: &TransferFunction) -> (f64, f64) {
             hi = hi.max(p[1]);
         }
     }
-    if !(hi > lo) { (lo - 1.0, lo + 1.0) } else { (lo, hi) }
+    if !(hi > lo) {
+        (lo - 1.0, lo + 1.0)
+    } else {
+        (lo, hi)
+    }
 }
 
 #[cfg(test)]
@@ -316,7 +324,10 @@ mod tests {
     fn identity_histogram_is_the_normal_density() {
         let (lo, hi, h) = height_histogram(&TransferFunction::Identity, 12);
         // The 0.1% quantile of N(0, 1) is −3.0902.
-        assert!((lo + 3.0902).abs() < 0.01 && (hi - 3.0902).abs() < 0.01, "{lo} {hi}");
+        assert!(
+            (lo + 3.0902).abs() < 0.01 && (hi - 3.0902).abs() < 0.01,
+            "{lo} {hi}"
+        );
         let total: f64 = h.iter().sum();
         assert!((total - 1.0).abs() < 1e-8, "{total}");
         // Bin [0, 3.09/6): Φ(0.515) − Φ(0) = 0.1967 (tails are clamped into the end bins).

@@ -2,7 +2,7 @@
 //! handle to move it), the selected stop's colour and position, interpolation, flip, distribute and
 //! the built-in maps.
 
-use egui::{Color32, Pos2, Rect, Sense, Stroke, Ui, Vec2, Role, WidgetInfo};
+use egui::{Color32, Pos2, Rect, Role, Sense, Stroke, Ui, Vec2, WidgetInfo};
 use lodestone_core::colormap::{ColorStop, Gradient, Interpolation, linear_to_srgb};
 
 /// Persistent UI state of the editor (which stop is selected).
@@ -52,10 +52,8 @@ impl GradientEditor {
         let pad = ((hi - lo) * 0.08).max(0.25);
         let (vlo, vhi) = (lo - pad, hi + pad);
         let width = ui.available_width().max(120.0);
-        let (rect, bar) = ui.allocate_exact_size(
-            Vec2::new(width, BAR_HEIGHT + HANDLE + 4.0),
-            Sense::click(),
-        );
+        let (rect, bar) =
+            ui.allocate_exact_size(Vec2::new(width, BAR_HEIGHT + HANDLE + 4.0), Sense::click());
         bar.widget_info(|| {
             WidgetInfo::labeled(Role::Button, true, "Colour map bar (click to add a stop)")
         });
@@ -103,10 +101,8 @@ impl GradientEditor {
         for (i, s) in g.stops.iter().enumerate() {
             let x = to_x(s.position);
             let top = bar_rect.bottom() + 2.0;
-            let hr = Rect::from_center_size(
-                Pos2::new(x, top + HANDLE * 0.5),
-                Vec2::splat(HANDLE + 4.0),
-            );
+            let hr =
+                Rect::from_center_size(Pos2::new(x, top + HANDLE * 0.5), Vec2::splat(HANDLE + 4.0));
             let r = ui.interact(hr, ui.scope_id().with(("stop", i)), Sense::click_and_drag());
             r.widget_info(|| {
                 WidgetInfo::slider(true, s.position, format!("Colour stop {}", i + 1))

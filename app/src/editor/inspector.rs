@@ -29,9 +29,14 @@ fn slider_f64(
     tip: &str,
     log: bool,
 ) -> bool {
-    ui.add(Slider::new(v, range).text(text).logarithmic(log).clamping(egui::SliderClamping::Always))
-        .on_hover_text(tip)
-        .changed()
+    ui.add(
+        Slider::new(v, range)
+            .text(text)
+            .logarithmic(log)
+            .clamping(egui::SliderClamping::Always),
+    )
+    .on_hover_text(tip)
+    .changed()
 }
 
 impl Inspector {
@@ -155,19 +160,42 @@ impl Inspector {
                         .changed();
                 });
                 changed |= ui
-                    .add(Slider::new(&mut n.components, 1..=NoiseParams::MAX_COMPONENTS).text("Components"))
-                    .on_hover_text("Number of sinusoids; more is more Gaussian (excess kurtosis ≈ −3/(2N))")
+                    .add(
+                        Slider::new(&mut n.components, 1..=NoiseParams::MAX_COMPONENTS)
+                            .text("Components"),
+                    )
+                    .on_hover_text(
+                        "Number of sinusoids; more is more Gaussian (excess kurtosis ≈ −3/(2N))",
+                    )
                     .changed();
                 changed |= ui
                     .add(Slider::new(&mut n.octaves, 1..=12).text("Octaves"))
                     .on_hover_text("Frequency bands, each an octave above the last")
                     .changed();
-                changed |= slider_f64(ui, &mut n.gain, 0.0..=1.0, "Gain",
-                    "Amplitude ratio between successive octaves", false);
-                changed |= slider_f64(ui, &mut n.bandwidth, 0.0..=1.5, "Bandwidth",
-                    "Relative spread of |k| within an octave (0 = one ring)", false);
-                changed |= slider_f64(ui, &mut n.frequency, 0.01..=100.0, "Frequency",
-                    "Base frequency (cycles per unit), used when σ_h or σ_n is 0; otherwise the frequencies follow from σ_n/σ_h", true);
+                changed |= slider_f64(
+                    ui,
+                    &mut n.gain,
+                    0.0..=1.0,
+                    "Gain",
+                    "Amplitude ratio between successive octaves",
+                    false,
+                );
+                changed |= slider_f64(
+                    ui,
+                    &mut n.bandwidth,
+                    0.0..=1.5,
+                    "Bandwidth",
+                    "Relative spread of |k| within an octave (0 = one ring)",
+                    false,
+                );
+                changed |= slider_f64(
+                    ui,
+                    &mut n.frequency,
+                    0.01..=100.0,
+                    "Frequency",
+                    "Base frequency (cycles per unit), used when σ_h or σ_n is 0; otherwise the frequencies follow from σ_n/σ_h",
+                    true,
+                );
             }
             Driver::Image { path, size } => {
                 ui.horizontal(|ui| {
@@ -186,8 +214,14 @@ impl Inspector {
                         changed = true;
                     }
                 });
-                changed |= slider_f64(ui, size, 0.01..=100.0, "Tile size",
-                    "World size of one tile of the image", true);
+                changed |= slider_f64(
+                    ui,
+                    size,
+                    0.01..=100.0,
+                    "Tile size",
+                    "World size of one tile of the image",
+                    true,
+                );
             }
         }
         changed
@@ -241,10 +275,22 @@ impl Inspector {
             }
             ColorModel::Attribute { mean, correlation } => {
                 for (c, name) in ["red", "green", "blue"].iter().enumerate() {
-                    changed |= slider_f64(ui, &mut mean[c], 0.0..=1.0, &format!("ā {name}"),
-                        "ā: mean attribute (linear RGB) of the channel [HN12 Eq. 17]", false);
-                    changed |= slider_f64(ui, &mut correlation[c], -1.0..=1.0, &format!("a_s {name}"),
-                        "a_s: attribute–height correlation; a(h) = ā + a_s·(2P(h) − 1), filtered as 1 − 2/(L+2) with masking L [HN12 Eq. 17]", false);
+                    changed |= slider_f64(
+                        ui,
+                        &mut mean[c],
+                        0.0..=1.0,
+                        &format!("ā {name}"),
+                        "ā: mean attribute (linear RGB) of the channel [HN12 Eq. 17]",
+                        false,
+                    );
+                    changed |= slider_f64(
+                        ui,
+                        &mut correlation[c],
+                        -1.0..=1.0,
+                        &format!("a_s {name}"),
+                        "a_s: attribute–height correlation; a(h) = ā + a_s·(2P(h) − 1), filtered as 1 − 2/(L+2) with masking L [HN12 Eq. 17]",
+                        false,
+                    );
                 }
             }
         }

@@ -9,6 +9,7 @@ pub mod gradient_editor;
 pub mod history;
 pub mod inspector;
 pub mod plots;
+pub mod priority;
 pub mod view_state;
 mod views;
 pub mod worker;
@@ -140,6 +141,8 @@ pub struct EditorApp {
     title: String,
     /// Hide timings (frame times, fps) so snapshots are reproducible.
     deterministic: bool,
+    /// `LODESTONE_FPS_LOG=1`: repaint continuously and log the window's frame rate (measurements).
+    fps_log: Option<f64>,
 }
 
 impl std::fmt::Debug for EditorApp {
@@ -221,6 +224,7 @@ impl EditorApp {
             persist: options.persist,
             title: String::new(),
             deterministic: false,
+            fps_log: std::env::var_os("LODESTONE_FPS_LOG").map(|_| 0.0),
         };
         app.recent.retain(|p| p.exists());
         app
@@ -249,7 +253,8 @@ impl EditorApp {
                         .get(m)
                         .is_some_and(|e| e.from.0 == self.generation && e.from.1 == self.generation)
             });
-        let plots_done = !self.view.show_plots || (!self.plots.busy() && !self.plots.points().is_empty());
+        let plots_done =
+            !self.view.show_plots || (!self.plots.busy() && !self.plots.points().is_empty());
         views_done && errors_done && plots_done
     }
 
@@ -496,7 +501,19 @@ impl EditorApp {
     fn poll_worker(&mut self, ctx: &egui::Context) {
         for ev in self.worker.poll() {
             match ev {
-                Event::Ready { adapter } => self.device = DeviceStatus::Ready(adapter),
+                Event::Ready { adapter, software } => {
+                    // A software rasterizer takes seconds per full-resolution frame: start at half
+                    // resolution (the Resolution menu raises it).
+                    if software && self.view.max_scale > 0.5 && !self.deterministic {
+                        self.view.max_scale = 0.5;
+                        self.notify(
+                            ctx,
+                            "Software GPU adapter: views render at 50% resolution (raise it under Resolution)",
+                            false,
+                        );
+                    }
+                    self.device = DeviceStatus::Ready(adapter);
+                }
                 Event::NoAdapter(e) => self.device = DeviceStatus::Failed(e),
                 Event::MaterialError(e) => self.material_error = Some(e),
                 Event::RenderError(e) => self.notify(ctx, e, true),
@@ -618,14 +635,20 @@ impl EditorApp {
         let ctx = ui.ctx().clone();
         egui::MenuBar::new().ui(ui, |ui| {
             ui.menu_button("File", |ui| {
-                if ui.add(egui::Button::new("New").shortcut_text("Ctrl+N")).clicked() {
+                if ui
+                    .add(egui::Button::new("New").shortcut_text("Ctrl+N"))
+                    .clicked()
+                {
                     if self.dirty() {
                         self.pending = Some(Pending::New);
                     } else {
                         self.new_material();
                     }
                 }
-                if ui.add(egui::Button::new("Open…").shortcut_text("Ctrl+O")).clicked() {
+                if ui
+                    .add(egui::Button::new("Open…").shortcut_text("Ctrl+O"))
+                    .clicked()
+                {
                     self.open_dialog(&ctx);
                 }
                 ui.menu_button("Open recent", |ui| {
@@ -650,7 +673,10 @@ impl EditorApp {
                     }
                 });
                 ui.separator();
-                if ui.add(egui::Button::new("Save").shortcut_text("Ctrl+S")).clicked() {
+                if ui
+                    .add(egui::Button::new("Save").shortcut_text("Ctrl+S"))
+                    .clicked()
+                {
                     self.save(&ctx);
                 }
                 if ui
@@ -662,7 +688,9 @@ impl EditorApp {
                 ui.separator();
                 if ui
                     .button("Export views (PNG + EXR)…")
-                    .on_hover_text("Write the current image of every view: 8-bit sRGB PNG and linear EXR")
+                    .on_hover_text(
+                        "Write the current image of every view: 8-bit sRGB PNG and linear EXR",
+                    )
                     .clicked()
                     && let Some(dir) = rfd::FileDialog::new().pick_folder()
                 {
@@ -768,7 +796,11 @@ impl EditorApp {
                 ui.weak(format!("UI {fps:.0} fps"));
             }
             let now = ui.input(|i| i.time);
-            if let Some(n) = self.notice.as_ref().filter(|n| n.error || now - n.time < 10.0) {
+            if let Some(n) = self
+                .notice
+                .as_ref()
+                .filter(|n| n.error || now - n.time < 10.0)
+            {
                 ui.separator();
                 if n.error {
                     ui.colored_label(ui.visuals().error_fg_color, &n.text);
@@ -783,7 +815,8 @@ impl EditorApp {
         if self.frame_times.len() < 2 {
             return 0.0;
         }
-        let span = self.frame_times.back().unwrap_or(&0.0) - self.frame_times.front().unwrap_or(&0.0);
+        let span =
+            self.frame_times.back().unwrap_or(&0.0) - self.frame_times.front().unwrap_or(&0.0);
         if span > 0.0 {
             (self.frame_times.len() - 1) as f64 / span
         } else {
@@ -833,8 +866,14 @@ impl EditorApp {
     }
 
     fn handle_drops(&mut self, ctx: &egui::Context) {
-        let dropped: Vec<PathBuf> =
-            ctx.input(|i| i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).filter(|p| !p.as_os_str().is_empty()).collect());
+        let dropped: Vec<PathBuf> = ctx.input(|i| {
+            i.raw
+                .dropped_files
+                .iter()
+                .map(|f| f.path().to_path_buf())
+                .filter(|p| !p.as_os_str().is_empty())
+                .collect()
+        });
         if let Some(p) = dropped.into_iter().next() {
             self.request_open(ctx, p);
         }
@@ -879,6 +918,25 @@ impl eframe::App for EditorApp {
             self.frame_times.pop_front();
         }
         self.last_frame = Some(now);
+        if let Some(last) = self.fps_log {
+            ctx.request_repaint();
+            if now - last > 2.0 {
+                let truth = self
+                    .shown
+                    .get(&ViewMode::Truth)
+                    .map_or(0, |s| s.frame.samples);
+                let scale = self
+                    .shown
+                    .get(&ViewMode::Filtered)
+                    .map_or(0.0, |s| s.frame.scale);
+                log::warn!(
+                    "fps {:.1} (truth {truth}/{} spp, analytic scale {scale})",
+                    self.fps(),
+                    self.view.truth_spp
+                );
+                self.fps_log = Some(now);
+            }
+        }
         self.poll_worker(&ctx);
         self.plots.poll();
         self.handle_drops(&ctx);
@@ -936,7 +994,8 @@ impl eframe::App for EditorApp {
         if self.material.validate().is_ok() {
             self.request_views();
         }
-        self.history.settle(&self.material, ctx.egui_is_using_pointer());
+        self.history
+            .settle(&self.material, ctx.egui_is_using_pointer());
         self.confirm_dialog(&ctx);
         self.update_title(&ctx);
     }
@@ -966,7 +1025,13 @@ fn short(m: ViewMode) -> &'static str {
 fn slug(name: &str) -> String {
     let s: String = name
         .chars()
-        .map(|c| if c.is_alphanumeric() { c.to_ascii_lowercase() } else { '-' })
+        .map(|c| {
+            if c.is_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '-'
+            }
+        })
         .collect();
     let s = s.trim_matches('-').to_string();
     if s.is_empty() { "material".into() } else { s }

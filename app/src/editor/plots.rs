@@ -138,6 +138,7 @@ impl AnglePlots {
             *b = true;
         }
         std::thread::spawn(move || {
+            super::priority::lower_current_thread();
             let cancel = || counter.load(Ordering::SeqCst) != generation;
             let r = compute(&m, light, azimuth_deg, &cancel);
             if !cancel() {
@@ -217,7 +218,11 @@ impl AnglePlots {
                     .include_x(90.0)
                     .allow_scroll(false)
                     .show(ui, |plot| {
-                        plot.line(Line::new("Ground truth", curve(&|p| p.truth)).color(TRUTH).width(2.5));
+                        plot.line(
+                            Line::new("Ground truth", curve(&|p| p.truth))
+                                .color(TRUTH)
+                                .width(2.5),
+                        );
                         plot.line(Line::new("Naive MIP", curve(&|p| p.naive)).color(NAIVE));
                         plot.line(
                             Line::new("View-independent", curve(&|p| p.view_independent)).color(VI),
@@ -242,11 +247,15 @@ impl AnglePlots {
                             Line::new("Naive MIP", curve(&|p| rel(p.naive, p.truth))).color(NAIVE),
                         );
                         plot.line(
-                            Line::new("View-independent", curve(&|p| rel(p.view_independent, p.truth)))
-                                .color(VI),
+                            Line::new(
+                                "View-independent",
+                                curve(&|p| rel(p.view_independent, p.truth)),
+                            )
+                            .color(VI),
                         );
                         plot.line(
-                            Line::new("Filtered", curve(&|p| rel(p.filtered, p.truth))).color(FILTERED),
+                            Line::new("Filtered", curve(&|p| rel(p.filtered, p.truth)))
+                                .color(FILTERED),
                         );
                     });
             });

@@ -67,7 +67,8 @@ fn loads_a_preset_and_edits_undo_redo() {
 
     // Move σ_h with the slider.
     let before = h.state().material().heights.sigma_h;
-    h.get_by_role_and_label(egui::accesskit::Role::Slider, "σ_h").set_value_accesskit(0.25);
+    h.get_by_role_and_label(egui::accesskit::Role::Slider, "σ_h")
+        .set_value_accesskit(0.25);
     h.step();
     h.step();
     let after = h.state().material().heights.sigma_h;
@@ -90,7 +91,11 @@ fn loads_a_preset_and_edits_undo_redo() {
     h.step();
     assert_eq!(*h.state().material(), m);
     let notice = h.state().notice.clone().expect("a notice");
-    assert!(notice.error && notice.text.contains("line 1"), "{}", notice.text);
+    assert!(
+        notice.error && notice.text.contains("line 1"),
+        "{}",
+        notice.text
+    );
 }
 
 #[test]
@@ -139,12 +144,22 @@ fn error_view_toggles_and_window_snapshots() {
     h.step();
     assert!(h.state().view.show_error);
     settle(&mut h, Duration::from_secs(240));
-    let e = h.state().errors.get(&ViewMode::Naive).expect("naive error map");
-    let f = h.state().errors.get(&ViewMode::Filtered).expect("filtered error map");
+    let e = h
+        .state()
+        .errors
+        .get(&ViewMode::Naive)
+        .expect("naive error map");
+    let f = h
+        .state()
+        .errors
+        .get(&ViewMode::Filtered)
+        .expect("filtered error map");
     assert!(e.stats.rmse.is_finite() && f.stats.rmse.is_finite());
     h.snapshot_options(
         "editor_grazing_errors",
-        &SnapshotOptions::new().threshold(2.0).max_failed_pixels(4000),
+        &SnapshotOptions::new()
+            .threshold(2.0)
+            .max_failed_pixels(4000),
     );
     h.get_by_label("Error maps").click();
     h.step();
@@ -162,7 +177,9 @@ fn default_window_snapshot_at_1280x720() {
     settle(&mut h, Duration::from_secs(240));
     h.snapshot_options(
         "editor_default_1280x720",
-        &SnapshotOptions::new().threshold(2.0).max_failed_pixels(4000),
+        &SnapshotOptions::new()
+            .threshold(2.0)
+            .max_failed_pixels(4000),
     );
 }
 
@@ -177,7 +194,48 @@ fn without_an_adapter_the_window_still_opens_and_says_why() {
     h.step();
     assert!(no_adapter(&h));
     // Editing still works.
-    h.get_by_role_and_label(egui::accesskit::Role::Slider, "σ_h").set_value_accesskit(0.2);
+    h.get_by_role_and_label(egui::accesskit::Role::Slider, "σ_h")
+        .set_value_accesskit(0.2);
     h.step();
     assert!((h.state().material().heights.sigma_h - 0.2).abs() < 1e-9);
+}
+
+/// Regenerates `screenshots/app/*.png`: the editor in three characteristic states at 1600×900
+/// (default; grazing with error maps; a transfer-function material). Slow on a software adapter
+/// (minutes), so it is ignored by default:
+/// `cargo test --release -p lodestone -- --ignored regenerate_app_screenshots`.
+#[test]
+#[ignore = "regenerates screenshots/app (slow); run explicitly"]
+fn regenerate_app_screenshots() {
+    let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("../screenshots/app");
+    std::fs::create_dir_all(&out).expect("screenshots/app");
+    let shoot = |name: &str, setup: &dyn Fn(&mut Harness<'static, EditorApp>)| {
+        let mut h = harness(1600.0, 900.0, DeviceSource::Headless);
+        h.step();
+        if no_adapter(&h) {
+            panic!("no adapter");
+        }
+        {
+            let app = h.state_mut();
+            app.view.max_scale = 0.5;
+            app.view.truth_spp = 32;
+        }
+        setup(&mut h);
+        settle(&mut h, Duration::from_secs(1800));
+        let img = h.render().expect("render");
+        img.save(out.join(format!("{name}.png"))).expect("save");
+    };
+    shoot("default", &|_| {});
+    shoot("grazing-error-maps", &|h| {
+        let app = h.state_mut();
+        app.view.camera.elevation_deg = 80.0;
+        app.view.camera.distance = 6.0;
+        app.view.show_error = true;
+        app.view.error_scale = 0.05;
+    });
+    shoot("transfer-function-moss", &|h| {
+        let ctx = h.ctx.clone();
+        h.state_mut().open_path(&ctx, &preset("moss.ron"));
+        h.state_mut().view.camera.elevation_deg = 60.0;
+    });
 }

@@ -2,6 +2,7 @@
 //! and the zoom sweep animation.
 
 use lodestone_core::camera::Camera;
+use lodestone_core::cylinder::Shape;
 use lodestone_core::smith::direction;
 use lodestone_render::{Scene, ViewMode};
 use serde::{Deserialize, Serialize};
@@ -89,6 +90,8 @@ pub struct ViewState {
     pub widths: [f32; 2],
     /// Show the plots panel.
     pub show_plots: bool,
+    /// The object: the plane or a cylinder.
+    pub shape: Shape,
 }
 
 impl Default for ViewState {
@@ -111,6 +114,7 @@ impl Default for ViewState {
             max_scale: 1.0,
             widths: [1.0 / 3.0, 1.0 / 3.0],
             show_plots: true,
+            shape: Shape::Plane,
         }
     }
 }
@@ -129,6 +133,7 @@ impl ViewState {
         Scene {
             camera: self.camera,
             light: self.light(),
+            shape: self.shape,
         }
     }
 
@@ -219,7 +224,11 @@ impl Sweep {
             s - u
         } else {
             u -= s - lo;
-            if u < hi - lo { lo + u } else { hi - (u - (hi - lo)) }
+            if u < hi - lo {
+                lo + u
+            } else {
+                hi - (u - (hi - lo))
+            }
         };
         Some(ln.exp())
     }

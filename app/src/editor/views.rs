@@ -4,8 +4,9 @@
 use super::gradient_editor::color32;
 use super::view_state::{DISTANCE_RANGE, Mode};
 use super::{DeviceStatus, EditorApp};
-use egui::{Color32, Pos2, Rect, Sense, Stroke, Ui, Vec2, Role, WidgetInfo};
+use egui::{Color32, Pos2, Rect, Role, Sense, Stroke, Ui, Vec2, WidgetInfo};
 use lodestone_core::camera::Camera;
+use lodestone_core::cylinder::Shape;
 use lodestone_render::ViewMode;
 
 /// Width of the draggable gap between viewports.
@@ -151,6 +152,31 @@ impl EditorApp {
                     .on_hover_text("Ground-truth rays per pixel to accumulate (progressive, one per pixel per frame)");
                 });
                 ui.horizontal(|ui| {
+                    let is_cyl = matches!(self.view.shape, Shape::Cylinder { .. });
+                    let mut want_cyl = is_cyl;
+                    egui::ComboBox::from_label("Object")
+                        .selected_text(if is_cyl { "Cylinder" } else { "Plane" })
+                        .show_ui(ui, |ui| {
+                            ui.selectable_value(&mut want_cyl, false, "Plane");
+                            ui.selectable_value(&mut want_cyl, true, "Cylinder");
+                        })
+                        .response
+                        .on_hover_text("The unbounded plane, or a cylinder (silhouettes and grazing light) whose top line passes through the camera target");
+                    if want_cyl != is_cyl {
+                        self.view.shape = if want_cyl {
+                            Shape::Cylinder { radius: 1.5 }
+                        } else {
+                            Shape::Plane
+                        };
+                    }
+                    if let Shape::Cylinder { radius } = &mut self.view.shape {
+                        ui.add(
+                            egui::Slider::new(radius, 0.1..=50.0)
+                                .logarithmic(true)
+                                .text("Radius"),
+                        )
+                        .on_hover_text("Cylinder radius (world units)");
+                    }
                     egui::ComboBox::from_label("Resolution")
                         .selected_text(format!("{:.0}%", self.view.max_scale * 100.0))
                         .show_ui(ui, |ui| {
@@ -187,7 +213,10 @@ impl EditorApp {
             });
         });
         if let Some(e) = &self.material_error {
-            ui.colored_label(ui.visuals().error_fg_color, format!("Cannot render this material: {e}"));
+            ui.colored_label(
+                ui.visuals().error_fg_color,
+                format!("Cannot render this material: {e}"),
+            );
         }
     }
 
@@ -205,11 +234,17 @@ impl EditorApp {
             && let Some(p) = resp.interact_pointer_pos()
         {
             let d = (p - c) / r;
-            self.view.set_light_from_disc(f64::from(d.x), f64::from(-d.y));
+            self.view
+                .set_light_from_disc(f64::from(d.x), f64::from(-d.y));
         }
         let painter = ui.painter_at(rect);
         let vis = ui.visuals();
-        painter.circle(c, r, vis.extreme_bg_color, Stroke::new(1.0, vis.weak_text_color()));
+        painter.circle(
+            c,
+            r,
+            vis.extreme_bg_color,
+            Stroke::new(1.0, vis.weak_text_color()),
+        );
         painter.circle_stroke(c, r * 0.5, Stroke::new(0.5, vis.weak_text_color()));
         // The camera's azimuth, for orientation.
         let az = self.view.camera.azimuth_deg.to_radians();
@@ -217,7 +252,12 @@ impl EditorApp {
         painter.line_segment([c, cam], Stroke::new(1.0, vis.weak_text_color()));
         let (x, y) = self.view.light_disc();
         let lp = c + Vec2::new(x as f32, -y as f32) * r;
-        painter.circle(lp, 5.0, Color32::from_rgb(255, 210, 80), Stroke::new(1.0, Color32::BLACK));
+        painter.circle(
+            lp,
+            5.0,
+            Color32::from_rgb(255, 210, 80),
+            Stroke::new(1.0, Color32::BLACK),
+        );
     }
 
     fn label_row(&self, ui: &Ui, rect: Rect, title: &str, extra: Option<String>) {
@@ -310,7 +350,11 @@ impl EditorApp {
                 ui.painter().text(
                     img.center(),
                     egui::Align2::CENTER_CENTER,
-                    if show_error { "waiting for ground truth…" } else { "rendering…" },
+                    if show_error {
+                        "waiting for ground truth…"
+                    } else {
+                        "rendering…"
+                    },
                     egui::FontId::proportional(14.0),
                     ui.visuals().weak_text_color(),
                 );
@@ -334,13 +378,22 @@ impl EditorApp {
             let t = i as f64 / f64::from(n - 1);
             let x0 = r.left() + r.width() * i as f32 / n as f32;
             ui.painter().rect_filled(
-                Rect::from_min_size(Pos2::new(x0, r.top()), Vec2::new(r.width() / n as f32 + 0.5, r.height())),
+                Rect::from_min_size(
+                    Pos2::new(x0, r.top()),
+                    Vec2::new(r.width() / n as f32 + 0.5, r.height()),
+                ),
                 0.0,
                 color32(g.sample(t)),
             );
         }
         let font = egui::FontId::proportional(11.0);
-        ui.painter().text(r.left_bottom() + Vec2::new(0.0, 1.0), egui::Align2::LEFT_TOP, "0", font.clone(), Color32::WHITE);
+        ui.painter().text(
+            r.left_bottom() + Vec2::new(0.0, 1.0),
+            egui::Align2::LEFT_TOP,
+            "0",
+            font.clone(),
+            Color32::WHITE,
+        );
         ui.painter().text(
             r.right_bottom() + Vec2::new(0.0, 1.0),
             egui::Align2::RIGHT_TOP,
@@ -382,7 +435,9 @@ impl EditorApp {
             };
             let _ = side;
             let mut m = if k == 0 { ab.left } else { ab.right };
-            let mut child = ui.new_child(egui::UiBuilder::new().max_rect(Rect::from_min_size(pos, Vec2::new(180.0, 24.0))));
+            let mut child = ui.new_child(
+                egui::UiBuilder::new().max_rect(Rect::from_min_size(pos, Vec2::new(180.0, 24.0))),
+            );
             egui::ComboBox::from_id_salt(("ab-mode", k))
                 .selected_text(m.label())
                 .show_ui(&mut child, |ui| {
@@ -396,7 +451,10 @@ impl EditorApp {
                 ab.right = m;
             }
         }
-        let handle = Rect::from_center_size(Pos2::new(split_x, img.center().y), Vec2::new(10.0, img.height()));
+        let handle = Rect::from_center_size(
+            Pos2::new(split_x, img.center().y),
+            Vec2::new(10.0, img.height()),
+        );
         let resp = ui
             .interact(handle, ui.scope_id().with("ab-split"), Sense::drag())
             .on_hover_cursor(egui::CursorIcon::ResizeHorizontal);
@@ -405,7 +463,10 @@ impl EditorApp {
             ab.split = (ab.split + resp.drag_delta().x / img.width()).clamp(0.0, 1.0);
         }
         ui.painter().line_segment(
-            [Pos2::new(split_x, img.top()), Pos2::new(split_x, img.bottom())],
+            [
+                Pos2::new(split_x, img.top()),
+                Pos2::new(split_x, img.bottom()),
+            ],
             Stroke::new(2.0, Color32::WHITE),
         );
         self.view.ab = Some(ab);

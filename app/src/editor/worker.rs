@@ -14,7 +14,9 @@
 
 use lodestone_core::footprint::Prepared;
 use lodestone_core::material::Material;
-use lodestone_render::{GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget};
+use lodestone_render::{
+    GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
+};
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, TryRecvError};
 use std::time::{Duration, Instant};
@@ -62,6 +64,8 @@ pub enum Event {
     Ready {
         /// "name (backend, type)".
         adapter: String,
+        /// The adapter is a software rasterizer (llvmpipe, lavapipe, WARP).
+        software: bool,
     },
     /// No device: nothing will be drawn.
     NoAdapter(String),
@@ -102,6 +106,8 @@ impl Worker {
         let spawned = std::thread::Builder::new()
             .name("lodestone-render".into())
             .spawn(move || {
+                // Before the device exists, so its rasterizer threads inherit the priority.
+                super::priority::lower_current_thread();
                 let send = |e: Event| {
                     let _ = ev_tx.send(e);
                     repaint();
@@ -116,6 +122,7 @@ impl Worker {
                     Ok(ctx) => {
                         send(Event::Ready {
                             adapter: ctx.describe(),
+                            software: ctx.is_software(),
                         });
                         State::new(Renderer::new(ctx)).run(&req_rx, &send);
                     }
@@ -367,6 +374,7 @@ impl State {
 mod tests {
     use super::*;
     use lodestone_core::camera::Camera;
+    use lodestone_core::cylinder::Shape;
     use lodestone_core::smith::direction;
 
     fn request(generation: u64, spp: u32) -> Request {
@@ -376,6 +384,7 @@ mod tests {
             scene: Scene {
                 camera: Camera::default(),
                 light: direction(0.5, 1.0),
+                shape: Shape::Plane,
             },
             size: [32, 24],
             modes: vec![ViewMode::Naive, ViewMode::Filtered, ViewMode::Truth],

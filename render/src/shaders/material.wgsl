@@ -27,7 +27,7 @@ struct Params {
     dh_ln_max: f32,
     width: u32,
     height: u32,
-    reserved: u32,
+    shape: u32,
     wave_count: u32,
     sigma_h: f32,
     albedo: f32,
@@ -63,8 +63,8 @@ struct Params {
     tp_knots: u32,
     waves_offset: u32,
     dh_offset: u32,
-    pad0: u32,
-    pad1: u32,
+    radius: f32,
+    slope_bound: f32,
 }
 
 @group(0) @binding(0) var<storage, read> params: Params;

@@ -1,4 +1,4 @@
-// One view of the plane scene: a compute pass over the image. Needs special.wgsl and material.wgsl.
+// One view of the plane or cylinder scene: a compute pass over the image. Needs special.wgsl and material.wgsl.
 // Modes: 0 naive MIP, 1 view-independent filtering, 2 filtered, 3 ground truth (progressive: one
 // low-discrepancy, Gaussian-filtered sub-pixel ray per pixel per frame; alpha counts samples).
 
@@ -55,7 +55,14 @@ fn view_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let idx = gid.y * params.width + gid.x;
     let centre = vec2<f32>(f32(gid.x) + 0.5, f32(gid.y) + 0.5);
     let wi = params.light;
-    if (params.mode < 3u) {
+    if (params.shape == 1u) {
+        if (params.mode < 3u) {
+            let dx = params.right * (2.0 * params.tan_half_fov * params.aspect / f32(params.width));
+            let dy = params.up * (-2.0 * params.tan_half_fov / f32(params.height));
+            accum[idx] = vec4<f32>(cylinder_pixel(params.mode, raw_dir(centre), dx, dy, wi), 1.0);
+            return;
+        }
+    } else if (params.mode < 3u) {
         let fp = plane_footprint(centre);
         var c = vec3<f32>(0.0);
         if (fp.hit) {
@@ -76,7 +83,12 @@ fn view_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let rad = sqrt(-2.0 * log(u1)) * params.pixel_sigma;
     let off = vec2<f32>(rad * cos(TAU * u2), rad * sin(TAU * u2));
     let d = normalize(raw_dir(centre + off));
-    let c = trace_ray(params.eye, d, wi);
+    var c: vec3<f32>;
+    if (params.shape == 1u) {
+        c = cylinder_trace_ray(params.eye, d, wi);
+    } else {
+        c = trace_ray(params.eye, d, wi);
+    }
     let prev = select(vec4<f32>(0.0), accum[idx], s > 0u);
     accum[idx] = prev + vec4<f32>(c, 1.0);
 }
