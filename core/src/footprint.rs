@@ -108,13 +108,31 @@ fn basis(n: DVec3) -> (DVec3, DVec3) {
 impl Prepared {
     /// Build the tables a material needs.
     pub fn new(material: &Material) -> Result<Self, PrepareError> {
+        Self::reusing(material, None)
+    }
+
+    /// Like [`Prepared::new`], but takes each table from `previous` when its inputs did not change
+    /// (the colour map's table depends only on the colour model and the table spec, the transfer
+    /// table only on g and the spec): an edit of σ_n or of the BRDF rebuilds nothing.
+    pub fn reusing(material: &Material, previous: Option<&Prepared>) -> Result<Self, PrepareError> {
         let surface = Surface::new(material).ok_or(PrepareError::ImageDriver)?;
         let spec = material.filtering.table;
-        let color_table = match &material.color {
-            ColorModel::Gradient { map, .. } => Some(map.preconvolve(spec)),
-            ColorModel::Attribute { .. } => None,
+        let same_spec = previous.is_some_and(|p| p.material.filtering.table == spec);
+        let color_table = match (&material.color, previous) {
+            (ColorModel::Gradient { .. }, Some(p))
+                if same_spec && p.material.color == material.color && p.color_table.is_some() =>
+            {
+                p.color_table.clone()
+            }
+            (ColorModel::Gradient { map, .. }, _) => Some(map.preconvolve(spec)),
+            (ColorModel::Attribute { .. }, _) => None,
         };
-        let transfer_table = material.heights.transfer.preconvolve(spec);
+        let transfer_table = match previous {
+            Some(p) if same_spec && p.material.heights.transfer == material.heights.transfer => {
+                p.transfer_table.clone()
+            }
+            _ => material.heights.transfer.preconvolve(spec),
+        };
         let g = material.heights.transfer.moments(0.0, 1.0);
         Ok(Self {
             material: material.clone(),
@@ -591,6 +609,53 @@ fn gauss(state: &mut u64) -> f64 {
     let u1 = next().max(1e-300);
     let u2 = next();
     (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
+}
+
+#[cfg(test)]
+mod reuse_tests {
+    use super::*;
+    use crate::colormap::Gradient;
+    use crate::transfer::Curve;
+
+    fn tables(p: &Prepared) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
+        (
+            p.color_table
+                .as_ref()
+                .map(|t| t.texels.clone())
+                .unwrap_or_default(),
+            p.transfer_table
+                .as_ref()
+                .map(|t| t.texels.clone())
+                .unwrap_or_default(),
+        )
+    }
+
+    /// Reused tables equal freshly built ones; a change of an input rebuilds exactly its table.
+    #[test]
+    fn tables_are_reused_only_when_their_inputs_are_unchanged() {
+        let mut m = Material::default();
+        m.heights.transfer = TransferFunction::Curve(Curve::moss());
+        let a = Prepared::new(&m).unwrap();
+        m.brdf.roughness = 0.4;
+        m.slopes.sigma_nx = 0.2;
+        let b = Prepared::reusing(&m, Some(&a)).unwrap();
+        assert_eq!(tables(&b), tables(&Prepared::new(&m).unwrap()));
+        assert_eq!(b.material, m);
+        if let ColorModel::Gradient { map, .. } = &mut m.color {
+            *map = Gradient::viridis(-2.0, 2.0);
+        }
+        let c = Prepared::reusing(&m, Some(&b)).unwrap();
+        assert_ne!(tables(&c).0, tables(&b).0, "colour table rebuilt");
+        assert_eq!(tables(&c).1, tables(&b).1, "transfer table kept");
+        assert_eq!(tables(&c), tables(&Prepared::new(&m).unwrap()));
+        m.filtering.table.size_m = 64;
+        let d = Prepared::reusing(&m, Some(&c)).unwrap();
+        assert_eq!(
+            tables(&d),
+            tables(&Prepared::new(&m).unwrap()),
+            "new spec rebuilds both"
+        );
+    }
 }
 
 #[cfg(test)]

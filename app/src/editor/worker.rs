@@ -159,6 +159,8 @@ impl Worker {
 struct State {
     renderer: Renderer,
     material: Option<(Arc<Material>, GpuMaterial)>,
+    /// The last prepared material (its tables are reused when their inputs did not change).
+    prepared: Option<Prepared>,
     /// Seconds per pixel of each analytic mode, measured.
     cost: Vec<(ViewMode, f64)>,
     truth: Option<ViewTarget>,
@@ -169,6 +171,7 @@ impl State {
         Self {
             renderer,
             material: None,
+            prepared: None,
             cost: Vec::new(),
             truth: None,
         }
@@ -215,10 +218,11 @@ impl State {
         {
             return true;
         }
-        match Prepared::new(material) {
+        match Prepared::reusing(material, self.prepared.as_ref()) {
             Ok(p) => {
                 let gm = GpuMaterial::new(self.renderer.context(), &p, [0.0, 0.0]);
                 self.material = Some((material.clone(), gm));
+                self.prepared = Some(p);
                 true
             }
             Err(e) => {
