@@ -258,8 +258,13 @@ impl Gradient {
         }
     }
 
-    /// Record every problem: no stops, non-finite positions or colours, unsorted positions,
-    /// negative colour components.
+    /// Largest stop position magnitude accepted (the driver has unit variance).
+    pub const MAX_POSITION: f64 = 1e6;
+    /// Largest linear colour component accepted (HDR headroom; reflectances are ≤ 1).
+    pub const MAX_COLOR: f64 = 1e3;
+
+    /// Record every problem: no stops, positions beyond ±[`Self::MAX_POSITION`], non-finite,
+    /// negative or above [`Self::MAX_COLOR`] colour components, unsorted positions.
     pub fn validate(&self, field: &str, problems: &mut Problems) {
         if self.stops.is_empty() {
             problems.push(
@@ -268,13 +273,23 @@ impl Gradient {
             );
         }
         for (i, s) in self.stops.iter().enumerate() {
-            problems.finite(&format!("{field}.stops[{i}].position"), s.position);
+            problems.in_range(
+                &format!("{field}.stops[{i}].position"),
+                s.position,
+                -Self::MAX_POSITION,
+                Self::MAX_POSITION,
+            );
             for (c, v) in s.color.iter().enumerate() {
                 let f = format!("{field}.stops[{i}].color[{c}]");
                 if !v.is_finite() {
                     problems.push(f, format!("must be a finite number, got {v}"));
                 } else if *v < 0.0 {
                     problems.push(f, format!("colour components cannot be negative, got {v}"));
+                } else if *v > Self::MAX_COLOR {
+                    problems.push(
+                        f,
+                        format!("colour components are at most {}, got {v}", Self::MAX_COLOR),
+                    );
                 }
             }
         }

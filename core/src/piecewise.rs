@@ -56,10 +56,10 @@ impl PiecewisePoly {
         self.knots.len().saturating_sub(1)
     }
 
-    /// Evaluate every channel at x into `out` (length = channels).
+    /// Evaluate every channel at x into `out` (length = channels). NaN evaluates as the left tail.
     pub fn eval(&self, x: f64, out: &mut [f64]) {
         let n = self.knots.len();
-        if n == 0 || x < self.knots[0] {
+        if n == 0 || !(x >= self.knots[0]) {
             out.copy_from_slice(&self.left);
             return;
         }

@@ -120,11 +120,15 @@ impl Worker {
                 };
                 match ctx {
                     Ok(ctx) => {
+                        let t0 = Instant::now();
+                        let renderer = Renderer::new(ctx);
+                        log::info!("view pipeline compiled in {:.1?}", t0.elapsed());
+                        let ctx = renderer.context();
                         send(Event::Ready {
                             adapter: ctx.describe(),
                             software: ctx.is_software(),
                         });
-                        State::new(Renderer::new(ctx)).run(&req_rx, &send);
+                        State::new(renderer).run(&req_rx, &send);
                     }
                     Err(e) => send(Event::NoAdapter(e)),
                 }
