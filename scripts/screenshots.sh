@@ -9,3 +9,7 @@ for preset in default moss dirt-in-crevices; do
         --view-deg 70 --light-deg 50 --light-azimuth-deg 120 --distance 8 --size 480x270 --spp 1024 \
         --out "screenshots/views/$preset" | tee "screenshots/views/$preset.txt"
 done
+# The curved object (default preset on a cylinder, seen side-on).
+./target/release/lodestone render --mode all --formats png --shape cylinder --radius 1.5 \
+    --view-deg 75 --view-azimuth-deg 90 --light-deg 40 --light-azimuth-deg 150 --distance 7 \
+    --size 320x180 --spp 128 --out screenshots/views/cylinder | tee screenshots/views/cylinder.txt
