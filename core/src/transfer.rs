@@ -229,7 +229,15 @@ impl Curve {
         }
     }
 
-    /// Record every problem: fewer than two points, non-finite values, unsorted f.
+    /// Largest |f| of a control point (the driver has unit variance: ±1e3 is far beyond any use).
+    pub const MAX_F: f64 = 1e3;
+    /// Largest |g| of a control point (heights are σ_h·g).
+    pub const MAX_G: f64 = 1e6;
+    /// Smallest non-zero distance in f between successive points.
+    pub const MIN_GAP: f64 = 1e-6;
+
+    /// Record every problem: fewer than two points, values beyond ±[`Self::MAX_F`] / ±[`Self::MAX_G`]
+    /// (or not finite), unsorted f.
     pub fn validate(&self, field: &str, problems: &mut Problems) {
         if self.points.len() < 2 {
             problems.push(
@@ -238,16 +246,38 @@ impl Curve {
             );
         }
         for (i, p) in self.points.iter().enumerate() {
-            problems.finite(&format!("{field}.points[{i}][0]"), p[0]);
-            problems.finite(&format!("{field}.points[{i}][1]"), p[1]);
+            problems.in_range(
+                &format!("{field}.points[{i}][0]"),
+                p[0],
+                -Self::MAX_F,
+                Self::MAX_F,
+            );
+            problems.in_range(
+                &format!("{field}.points[{i}][1]"),
+                p[1],
+                -Self::MAX_G,
+                Self::MAX_G,
+            );
         }
         for (i, w) in self.points.windows(2).enumerate() {
-            if w[1][0] < w[0][0] {
+            let gap = w[1][0] - w[0][0];
+            if gap < 0.0 {
                 problems.push(
                     format!("{field}.points[{}][0]", i + 1),
                     format!(
                         "points must be sorted by f: {} comes after {}",
                         w[1][0], w[0][0]
+                    ),
+                );
+            } else if gap > 0.0 && gap < Self::MIN_GAP {
+                // A near-vertical segment would have a slope beyond f64 (use equal f for a cliff).
+                problems.push(
+                    format!("{field}.points[{}][0]", i + 1),
+                    format!(
+                        "points closer than {} in f must be equal (a cliff): {} and {}",
+                        Self::MIN_GAP,
+                        w[0][0],
+                        w[1][0]
                     ),
                 );
             }
