@@ -151,8 +151,8 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
 pub enum Formats {
     /// 8-bit sRGB PNG only.
     Png,
-    /// Linear EXR only (error maps stay PNG).
+    /// Linear EXR only (views as EXR; error maps as PNG heat maps and EXR |mode − truth|).
     Exr,
-    /// Both.
+    /// Both (error maps as PNG heat maps and as linear EXR |mode − truth| per channel).
     Both,
 }

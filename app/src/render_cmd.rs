@@ -7,7 +7,7 @@ use lodestone_core::cylinder::Shape;
 use lodestone_core::footprint::Prepared;
 use lodestone_core::material::Material;
 use lodestone_core::smith::direction;
-use lodestone_render::error_map::{error_stats, heat_map};
+use lodestone_render::error_map::{abs_difference, error_stats, heat_map};
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
 };
@@ -133,6 +133,12 @@ pub fn render(
                     &heat_map(img, &truth, scale),
                     &out.join(format!("error_{name}.png")),
                 )?;
+                if formats != Formats::Png {
+                    save(
+                        &abs_difference(img, &truth),
+                        &out.join(format!("error_{name}.exr")),
+                    )?;
+                }
             }
             println!(
                 "error maps share the legend 0 … {scale:.5} (linear RGB), truth {spp} rays/pixel"

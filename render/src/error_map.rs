@@ -60,6 +60,28 @@ pub fn heat_gradient() -> Gradient {
     )
 }
 
+/// Per-channel absolute difference |image − reference| (linear RGB, weight 1), for EXR export.
+pub fn abs_difference(image: &LinearImage, reference: &LinearImage) -> LinearImage {
+    let (w, h) = (image.width, image.height);
+    let mut pixels = Vec::with_capacity((w * h) as usize);
+    for y in 0..h {
+        for x in 0..w {
+            let (a, b) = (image.rgb(x, y), reference.rgb(x, y));
+            pixels.push([
+                (a[0] - b[0]).abs(),
+                (a[1] - b[1]).abs(),
+                (a[2] - b[2]).abs(),
+                1.0,
+            ]);
+        }
+    }
+    LinearImage {
+        width: w,
+        height: h,
+        pixels,
+    }
+}
+
 /// Heat map of the per-pixel error (max over channels), `scale` mapping to the top of the scale
 /// (errors above it saturate). Same size as the inputs, no legend (the editor draws its own).
 pub fn error_heat(image: &LinearImage, reference: &LinearImage, scale: f64) -> LinearImage {
@@ -122,6 +144,17 @@ mod tests {
                 && (s.mean_abs - 0.25).abs() < 1e-7
         );
         assert_eq!(error_stats(&img(0.3), &img(0.3)).max, 0.0);
+    }
+
+    #[test]
+    fn abs_difference_is_per_channel() {
+        let a = img(0.5);
+        let mut b = img(0.25);
+        b.pixels[3] = [1.0, 0.5, 0.0, 2.0];
+        let d = abs_difference(&a, &b);
+        assert_eq!(d.rgb(0, 0), [0.25; 3]);
+        // Pixel 3 of b has weight 2: (0.5, 0.25, 0) after division.
+        assert_eq!(d.rgb(3, 0), [0.0, 0.25, 0.5]);
     }
 
     #[test]

@@ -379,7 +379,9 @@ impl EditorApp {
         self.history.redo(&mut self.material)
     }
 
-    /// Export the latest image of every shown view (PNG, sRGB 8-bit, and EXR, linear) into `dir`.
+    /// Export the latest image of every rendered view (PNG, sRGB 8-bit, and EXR, linear) into `dir`,
+    /// and for each analytic view its error against the ground truth (heat map PNG at the current
+    /// error scale, per-channel |mode − truth| EXR).
     pub fn export_views(&self, dir: &Path) -> Result<Vec<PathBuf>, String> {
         let mut written = Vec::new();
         for (mode, s) in &self.shown {
@@ -400,6 +402,30 @@ impl EditorApp {
                 .save(&exr)
                 .map_err(|e| format!("{}: {e}", exr.display()))?;
             written.extend([png, exr]);
+            // The error map against the ground truth, when one of the same size is there.
+            if let Some(t) = self.shown.get(&ViewMode::Truth).filter(|t| {
+                *mode != ViewMode::Truth
+                    && (t.frame.image.width, t.frame.image.height)
+                        == (s.frame.image.width, s.frame.image.height)
+            }) {
+                use lodestone_render::error_map::{abs_difference, error_heat};
+                let heat = error_heat(
+                    &s.frame.image,
+                    &t.frame.image,
+                    f64::from(self.view.error_scale),
+                );
+                let png = dir.join(format!("error_{name}.png"));
+                heat.to_srgb8()
+                    .save(&png)
+                    .map_err(|e| format!("{}: {e}", png.display()))?;
+                let exr = dir.join(format!("error_{name}.exr"));
+                image::DynamicImage::ImageRgba32F(
+                    abs_difference(&s.frame.image, &t.frame.image).to_linear_f32(),
+                )
+                .save(&exr)
+                .map_err(|e| format!("{}: {e}", exr.display()))?;
+                written.extend([png, exr]);
+            }
         }
         written.sort();
         Ok(written)

@@ -239,3 +239,50 @@ fn regenerate_app_screenshots() {
         h.state_mut().view.camera.elevation_deg = 60.0;
     });
 }
+
+#[test]
+fn exports_every_view_and_error_map_as_png_and_exr() {
+    let mut h = harness(800.0, 500.0, DeviceSource::Headless);
+    h.step();
+    if no_adapter(&h) {
+        eprintln!("skipped: no adapter");
+        return;
+    }
+    h.state_mut().view.show_plots = false;
+    h.state_mut().view.truth_spp = 1;
+    settle(&mut h, Duration::from_secs(240));
+    let dir = std::env::temp_dir().join(format!("lodestone-export-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("dir");
+    let written = h.state().export_views(&dir).expect("export");
+    let names: Vec<String> = written
+        .iter()
+        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    for want in [
+        "naive.png",
+        "naive.exr",
+        "truth.png",
+        "truth.exr",
+        "filtered.png",
+        "filtered.exr",
+        "error_naive.png",
+        "error_naive.exr",
+        "error_filtered.png",
+        "error_filtered.exr",
+    ] {
+        assert!(
+            names.iter().any(|n| n == want),
+            "{want} missing from {names:?}"
+        );
+    }
+    // The EXR holds linear values equal to the image's.
+    let exr = image::open(dir.join("filtered.exr"))
+        .expect("exr")
+        .to_rgba32f();
+    let shown = &h.state().shown[&ViewMode::Filtered].frame.image;
+    assert_eq!((exr.width(), exr.height()), (shown.width, shown.height));
+    let (x, y) = (shown.width / 2, shown.height - 1);
+    let c = shown.rgb(x, y);
+    let e = exr.get_pixel(x, y);
+    assert!((0..3).all(|k| (e[k] - c[k]).abs() < 1e-6), "{e:?} vs {c:?}");
+}
