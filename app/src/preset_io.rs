@@ -3,39 +3,51 @@
 //! Saves are atomic: the text goes to a temporary file beside the target, is flushed to disk, then
 //! renamed over the target, so a crash mid-save never leaves a truncated preset.
 
-use lodestone_core::material::{Material, MaterialError};
+use lodestone_core::image_driver::ImageDriver;
+use lodestone_core::material::{Driver, Material, MaterialError};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// The built-in default preset.
 pub const DEFAULT_PRESET: &str = include_str!("../../presets/default.ron");
 
-/// Why a preset could not be loaded or saved.
+/// Why a preset could not be loaded or saved. (The wrapped errors are part of the message, not a
+/// `source`, so `{:#}` chains do not print them twice.)
 #[derive(Debug, thiserror::Error)]
 pub enum PresetError {
     /// The file cannot be read.
-    #[error("cannot read {path}: {source}")]
+    #[error("cannot read {path}: {error}")]
     Read {
         /// The file.
         path: PathBuf,
         /// The OS error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The file is not a valid material (line and column inside).
-    #[error("{path}: {source}")]
+    #[error("{path}: {error}")]
     Material {
         /// The file.
         path: PathBuf,
         /// What is wrong.
-        source: MaterialError,
+        error: MaterialError,
+    },
+    /// The material's image driver cannot be used.
+    #[error("{preset}: driver image {image}: {reason}")]
+    Image {
+        /// The preset.
+        preset: PathBuf,
+        /// The image file, resolved against the preset's folder.
+        image: PathBuf,
+        /// What is wrong (missing, not an image, too large, not finite).
+        reason: String,
     },
     /// The file cannot be written.
-    #[error("cannot save {path}: {source}")]
+    #[error("cannot save {path}: {error}")]
     Write {
         /// The file.
         path: PathBuf,
         /// The OS error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
 }
 
@@ -46,21 +58,45 @@ pub fn default_material() -> Material {
 
 /// Load and validate a preset file.
 pub fn load(path: &Path) -> Result<Material, PresetError> {
-    let text = std::fs::read_to_string(path).map_err(|source| PresetError::Read {
+    let text = std::fs::read_to_string(path).map_err(|error| PresetError::Read {
         path: path.to_owned(),
-        source,
+        error,
     })?;
-    Material::from_ron(&text).map_err(|source| PresetError::Material {
+    let m = Material::from_ron(&text).map_err(|error| PresetError::Material {
         path: path.to_owned(),
-        source,
-    })
+        error,
+    })?;
+    if let Driver::Image { path: image, .. } = &m.driver {
+        let dir = path.parent().unwrap_or(Path::new("."));
+        load_image_driver(path, &dir.join(image))?;
+    }
+    Ok(m)
+}
+
+/// Load and check a driver image: it must exist, decode, fit [`ImageDriver::MAX_SIDE`] (checked
+/// before decoding) and hold finite values.
+pub fn load_image_driver(preset: &Path, image: &Path) -> Result<ImageDriver, PresetError> {
+    let err = |reason: String| PresetError::Image {
+        preset: preset.to_owned(),
+        image: image.to_owned(),
+        reason,
+    };
+    let (w, h) = image::image_dimensions(image).map_err(|e| err(e.to_string()))?;
+    let max = ImageDriver::MAX_SIDE as u32;
+    if w > max || h > max {
+        return Err(err(format!("{w}×{h} is larger than the {max}×{max} limit")));
+    }
+    let img = image::open(image)
+        .map_err(|e| err(e.to_string()))?
+        .to_luma32f();
+    ImageDriver::new(w as usize, h as usize, img.as_raw()).map_err(|e| err(e.to_string()))
 }
 
 /// Write `text` to `path` atomically (temporary file in the same directory, fsync, rename).
 pub fn write_atomic(path: &Path, text: &str) -> Result<(), PresetError> {
-    let err = |source| PresetError::Write {
+    let err = |error| PresetError::Write {
         path: path.to_owned(),
-        source,
+        error,
     };
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
@@ -125,6 +161,40 @@ mod tests {
         std::fs::create_dir_all(blocked.join("x")).expect("dir");
         assert!(save(&blocked, &default_material()).is_err());
         assert_eq!(std::fs::read_to_string(&p).expect("read"), before);
+    }
+
+    #[test]
+    fn image_drivers_are_checked_on_load() {
+        let d = scratch("images");
+        let mut m = default_material();
+        m.driver = Driver::Image {
+            path: "drv.png".into(),
+            size: 1.0,
+        };
+        let p = d.join("img.ron");
+        save(&p, &m).expect("save");
+        // Missing.
+        let e = load(&p).expect_err("missing image").to_string();
+        assert!(e.contains("drv.png") && e.contains("img.ron"), "{e}");
+        // Not an image.
+        std::fs::write(d.join("drv.png"), b"definitely not a png").expect("write");
+        let e = load(&p).expect_err("corrupt image").to_string();
+        assert!(e.contains("drv.png"), "{e}");
+        // A real one.
+        image::GrayImage::from_fn(8, 4, |x, y| image::Luma([(x * 30 + y) as u8]))
+            .save(d.join("drv.png"))
+            .expect("png");
+        assert_eq!(load(&p).expect("valid image"), m);
+    }
+
+    #[test]
+    fn messages_say_it_once() {
+        let d = scratch("once");
+        let p = d.join("bad.ron");
+        std::fs::write(&p, "(version: 1,\n  name: oops").expect("write");
+        let e = anyhow::Error::from(load(&p).expect_err("bad"));
+        let text = format!("{e:#}");
+        assert_eq!(text.matches("line 2").count(), 1, "{text}");
     }
 
     #[test]
