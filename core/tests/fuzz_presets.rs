@@ -131,7 +131,7 @@ fn twelve_thousand_mutated_presets_never_panic() {
     let seed = std::env::var("LODESTONE_FUZZ_SEED")
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(0x10de_57);
+        .unwrap_or(0x0010_de57);
     let mut rng = Rng(seed);
     let (mut parse, mut invalid, mut too_new, mut ok) = (0, 0, 0, 0);
     for i in 0..12_000 {
