@@ -93,6 +93,13 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Write the engine bundle: the pre-convolved tables (EXR), a manifest (JSON), and self-contained
+    /// WGSL and GLSL snippets that evaluate the filtered material from them.
+    Export {
+        /// Output directory (created if needed).
+        #[arg(long)]
+        out: PathBuf,
+    },
     /// Parse and validate a preset; exit code 2 and every problem on failure.
     Validate,
     /// Print the preset (the built-in default when --preset is omitted) as RON.

@@ -133,6 +133,14 @@ fn run(cli: Cli) -> Result<()> {
         Some(Command::Bench { size, frames, json }) => {
             render_cmd::bench(&material, size, frames, json)?
         }
+        Some(Command::Export { out }) => {
+            let written = preset_io::export_bundle(&material, &out)?;
+            println!(
+                "wrote {} files to {} (see manifest.json)",
+                written.len(),
+                out.display()
+            );
+        }
         Some(Command::Validate) => println!("ok: {} is a valid preset", material.name),
         Some(Command::Show) => println!("{}", material.to_ron()),
         Some(Command::Adapter) => {

@@ -120,6 +120,21 @@ pub fn write_atomic(path: &Path, text: &str) -> Result<(), PresetError> {
     result.map_err(err)
 }
 
+/// Write the engine bundle of `m` into `dir` (created if needed); returns the files written.
+pub fn export_bundle(m: &Material, dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
+    use anyhow::Context;
+    let prepared = lodestone_core::footprint::Prepared::new(m)?;
+    let files = lodestone_render::export::bundle(&prepared)?;
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let mut written = Vec::new();
+    for (name, bytes) in files {
+        let p = dir.join(name);
+        std::fs::write(&p, bytes).with_context(|| format!("writing {}", p.display()))?;
+        written.push(p);
+    }
+    Ok(written)
+}
+
 /// Save a material as a preset (atomically).
 pub fn save(path: &Path, m: &Material) -> Result<(), PresetError> {
     write_atomic(path, &m.to_ron())

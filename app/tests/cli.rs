@@ -101,3 +101,36 @@ fn no_adapter_exits_3_with_a_clear_message() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("no GPU adapter"), "{err}");
 }
+
+#[test]
+fn export_writes_the_engine_bundle() {
+    let dir = std::env::temp_dir().join(format!("lodestone-bundle-{}", std::process::id()));
+    let out = lodestone(&[
+        "--preset",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/../presets/moss.ron"),
+        "export",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "manifest.json",
+        "lodestone_filtered.wgsl",
+        "lodestone_filtered.glsl",
+        "params.bin",
+        "data.bin",
+        "color_table.exr",
+        "transfer_table.exr",
+        "effective_height.exr",
+        "material.ron",
+    ] {
+        assert!(dir.join(f).is_file(), "{f} missing");
+    }
+    let manifest: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
+    assert_eq!(manifest["material"], "Moss clumps (transfer function)");
+}

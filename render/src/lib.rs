@@ -7,6 +7,7 @@
 
 pub mod compute;
 pub mod error_map;
+pub mod export;
 pub mod gpu;
 pub mod gpu_types;
 pub mod renderer;

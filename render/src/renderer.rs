@@ -249,100 +249,109 @@ fn push_poly(data: &mut Vec<f32>, p: &PiecewisePoly, channels: &[usize]) -> u32 
     off
 }
 
+/// The material's data buffer (waves, tables, D_h, quadrature rule, curve polynomials, as f32) and
+/// the material part of the WGSL `Params`, with coordinates relative to `target`: each wave's phase
+/// absorbs 2π k·target in f64, so f32 phases stay accurate anywhere on the plane. Shared by the
+/// renderer and the engine bundle ([`crate::export`]).
+pub fn material_data(prepared: &Prepared, target: [f64; 2]) -> (Vec<f32>, GpuParams) {
+    let m = &prepared.material;
+    let s = &prepared.surface;
+    let mut data: Vec<f32> = Vec::new();
+    let mut lay = Layout {
+        waves: 0,
+        ..Layout::default()
+    };
+    for w in &s.noise.waves {
+        let phase = (w.phase + TAU * (w.k.x * target[0] + w.k.y * target[1])).rem_euclid(TAU);
+        data.extend([w.k.x as f32, w.k.y as f32, w.amplitude as f32, phase as f32]);
+    }
+    let mut base = GpuParams {
+        wave_count: s.noise.waves.len() as u32,
+        ..GpuParams::default()
+    };
+    if let Some(t) = &prepared.color_table {
+        lay.color_table = push_table(&mut data, t);
+        base.ct_size_m = t.size_m as u32;
+        base.ct_size_s = t.size_sigma as u32;
+        base.ct_m_min = t.m_min as f32;
+        base.ct_m_max = t.m_max as f32;
+        base.ct_sigma_max = t.sigma_max as f32;
+    }
+    if let Some(t) = &prepared.transfer_table {
+        lay.transfer_table = push_table(&mut data, t);
+        base.tt_size_m = t.size_m as u32;
+        base.tt_size_s = t.size_sigma as u32;
+        base.tt_m_min = t.m_min as f32;
+        base.tt_m_max = t.m_max as f32;
+        base.tt_sigma_max = t.sigma_max as f32;
+    }
+    let dh = EffectiveHeightTable::shared();
+    lay.dh = data.len() as u32;
+    for (a, b) in dh.mean.iter().zip(&dh.std) {
+        data.extend([*a as f32, *b as f32]);
+    }
+    let points = m.filtering.slope_points.max(1) as usize;
+    let (x, w) = hermite_rule(points);
+    lay.gh = data.len() as u32;
+    for (a, b) in x.iter().zip(w) {
+        data.extend([*a as f32, *b as f32]);
+    }
+    match &m.color {
+        ColorModel::Gradient { map, source } => {
+            let p = map.to_piecewise();
+            lay.color_poly = push_poly(&mut data, &p, &[0, 1, 2]);
+            base.cp_knots = p.knots.len() as u32;
+            base.color_kind = match source {
+                ColorSource::Driver => 0,
+                ColorSource::Height => 1,
+            };
+        }
+        ColorModel::Attribute { mean, correlation } => {
+            base.color_kind = 2;
+            base.attr_mean = mean.map(|v| v as f32);
+            base.attr_corr = correlation.map(|v| v as f32);
+        }
+    }
+    if let TransferFunction::Curve(c) = &m.heights.transfer {
+        let p = c.moment_poly();
+        lay.transfer_poly = push_poly(&mut data, &p, &[0, 2]);
+        base.tp_knots = p.knots.len() as u32;
+        base.transfer_kind = 1;
+    }
+    if data.is_empty() {
+        data.push(0.0);
+    }
+    base.waves_offset = lay.waves;
+    base.ct_offset = lay.color_table;
+    base.tt_offset = lay.transfer_table;
+    base.dh_offset = lay.dh;
+    base.dh_size = dh.mean.len() as u32;
+    base.dh_ln_min = dh.ln_l_min as f32;
+    base.dh_ln_max = dh.ln_l_max as f32;
+    base.gh_offset = lay.gh;
+    base.slope_points = points as u32;
+    base.cp_offset = lay.color_poly;
+    base.tp_offset = lay.transfer_poly;
+    base.sigma_h = s.sigma_h as f32;
+    base.albedo = m.brdf.albedo as f32;
+    base.specular = m.brdf.specular as f32;
+    base.roughness = m.brdf.roughness as f32;
+    base.h_max = s.h_max as f32;
+    base.g_lip = s.g_lip as f32;
+    base.min_step = s.min_step as f32;
+    base.slope_bound = s.slope_bound() as f32;
+    base.correlation = u32::from(m.filtering.correlation == Correlation::HeightDirection);
+    base.height_filter = u32::from(m.filtering.height_filter == HeightFilter::PaperFit);
+    base.g_mean = prepared.g_global.0 as f32;
+    base.g_std = prepared.g_global.1 as f32;
+    (data, base)
+}
+
 impl GpuMaterial {
-    /// Upload a prepared material with coordinates relative to `target` (the camera target): each
-    /// wave's phase absorbs 2π k·target in f64, so f32 phases stay accurate anywhere on the plane.
+    /// Upload a prepared material with coordinates relative to `target` (the camera target), see
+    /// [`material_data`].
     pub fn new(ctx: &GpuContext, prepared: &Prepared, target: [f64; 2]) -> Self {
-        let m = &prepared.material;
-        let s = &prepared.surface;
-        let mut data: Vec<f32> = Vec::new();
-        let mut lay = Layout {
-            waves: 0,
-            ..Layout::default()
-        };
-        for w in &s.noise.waves {
-            let phase = (w.phase + TAU * (w.k.x * target[0] + w.k.y * target[1])).rem_euclid(TAU);
-            data.extend([w.k.x as f32, w.k.y as f32, w.amplitude as f32, phase as f32]);
-        }
-        let mut base = GpuParams {
-            wave_count: s.noise.waves.len() as u32,
-            ..GpuParams::default()
-        };
-        if let Some(t) = &prepared.color_table {
-            lay.color_table = push_table(&mut data, t);
-            base.ct_size_m = t.size_m as u32;
-            base.ct_size_s = t.size_sigma as u32;
-            base.ct_m_min = t.m_min as f32;
-            base.ct_m_max = t.m_max as f32;
-            base.ct_sigma_max = t.sigma_max as f32;
-        }
-        if let Some(t) = &prepared.transfer_table {
-            lay.transfer_table = push_table(&mut data, t);
-            base.tt_size_m = t.size_m as u32;
-            base.tt_size_s = t.size_sigma as u32;
-            base.tt_m_min = t.m_min as f32;
-            base.tt_m_max = t.m_max as f32;
-            base.tt_sigma_max = t.sigma_max as f32;
-        }
-        let dh = EffectiveHeightTable::shared();
-        lay.dh = data.len() as u32;
-        for (a, b) in dh.mean.iter().zip(&dh.std) {
-            data.extend([*a as f32, *b as f32]);
-        }
-        let points = m.filtering.slope_points.max(1) as usize;
-        let (x, w) = hermite_rule(points);
-        lay.gh = data.len() as u32;
-        for (a, b) in x.iter().zip(w) {
-            data.extend([*a as f32, *b as f32]);
-        }
-        match &m.color {
-            ColorModel::Gradient { map, source } => {
-                let p = map.to_piecewise();
-                lay.color_poly = push_poly(&mut data, &p, &[0, 1, 2]);
-                base.cp_knots = p.knots.len() as u32;
-                base.color_kind = match source {
-                    ColorSource::Driver => 0,
-                    ColorSource::Height => 1,
-                };
-            }
-            ColorModel::Attribute { mean, correlation } => {
-                base.color_kind = 2;
-                base.attr_mean = mean.map(|v| v as f32);
-                base.attr_corr = correlation.map(|v| v as f32);
-            }
-        }
-        if let TransferFunction::Curve(c) = &m.heights.transfer {
-            let p = c.moment_poly();
-            lay.transfer_poly = push_poly(&mut data, &p, &[0, 2]);
-            base.tp_knots = p.knots.len() as u32;
-            base.transfer_kind = 1;
-        }
-        if data.is_empty() {
-            data.push(0.0);
-        }
-        base.waves_offset = lay.waves;
-        base.ct_offset = lay.color_table;
-        base.tt_offset = lay.transfer_table;
-        base.dh_offset = lay.dh;
-        base.dh_size = dh.mean.len() as u32;
-        base.dh_ln_min = dh.ln_l_min as f32;
-        base.dh_ln_max = dh.ln_l_max as f32;
-        base.gh_offset = lay.gh;
-        base.slope_points = points as u32;
-        base.cp_offset = lay.color_poly;
-        base.tp_offset = lay.transfer_poly;
-        base.sigma_h = s.sigma_h as f32;
-        base.albedo = m.brdf.albedo as f32;
-        base.specular = m.brdf.specular as f32;
-        base.roughness = m.brdf.roughness as f32;
-        base.h_max = s.h_max as f32;
-        base.g_lip = s.g_lip as f32;
-        base.min_step = s.min_step as f32;
-        base.slope_bound = s.slope_bound() as f32;
-        base.correlation = u32::from(m.filtering.correlation == Correlation::HeightDirection);
-        base.height_filter = u32::from(m.filtering.height_filter == HeightFilter::PaperFit);
-        base.g_mean = prepared.g_global.0 as f32;
-        base.g_std = prepared.g_global.1 as f32;
+        let (data, base) = material_data(prepared, target);
         let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("material data"),
             size: (data.len() * 4) as u64,

@@ -711,6 +711,21 @@ impl EditorApp {
                 {
                     self.save_as(&ctx);
                 }
+                if ui
+                    .button("Export engine bundle…")
+                    .on_hover_text("Tables (EXR), manifest (JSON) and WGSL/GLSL snippets that evaluate the filtered material in another engine")
+                    .clicked()
+                    && let Some(dir) = rfd::FileDialog::new().pick_folder()
+                {
+                    match preset_io::export_bundle(&self.material, &dir) {
+                        Ok(w) => self.notify(
+                            &ctx,
+                            format!("Engine bundle: {} files in {}", w.len(), dir.display()),
+                            false,
+                        ),
+                        Err(e) => self.notify(&ctx, format!("{e:#}"), true),
+                    }
+                }
                 ui.separator();
                 if ui
                     .button("Export views (PNG + EXR)…")
