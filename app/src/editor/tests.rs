@@ -231,7 +231,8 @@ fn regenerate_app_screenshots() {
         app.view.camera.elevation_deg = 80.0;
         app.view.camera.distance = 6.0;
         app.view.show_error = true;
-        app.view.error_scale = 0.05;
+        app.view.error_scale = 0.15;
+        app.view.truth_spp = 96;
     });
     shoot("transfer-function-moss", &|h| {
         let ctx = h.ctx.clone();
