@@ -93,7 +93,7 @@ impl Inspector {
                     &mut m.slopes.sigma_ny,
                     0.0..=2.0,
                     "σ_ny",
-                    "σ_ny: slope standard deviation along y (anisotropy when ≠ σ_nx) [HN12 Sec. 3]",
+                    "σ_ny: slope standard deviation along y (anisotropy when it differs from σ_nx) [HN12 Sec. 3]",
                     false,
                 );
                 ui.checkbox(&mut self.isotropic_lock, "Isotropic (σ_nx = σ_ny)")
@@ -165,7 +165,7 @@ impl Inspector {
                             .text("Components"),
                     )
                     .on_hover_text(
-                        "Number of sinusoids; more is more Gaussian (excess kurtosis ≈ −3/(2N))",
+                        "Number of sinusoids; more is more Gaussian (excess kurtosis about −3/(2N))",
                     )
                     .changed();
                 changed |= ui
@@ -266,7 +266,7 @@ impl Inspector {
                         ui.selectable_value(&mut s, ColorSource::Height, "Height");
                     })
                     .response
-                    .on_hover_text("Index the map by f [HNPN14 Sec. 4] or by the standardized height (h − h̄)/σ [HNPN14 Secs. 5.1, 7]");
+                    .on_hover_text("Index the map by f [HNPN14 Sec. 4] or by the standardized height (h − mean h)/σ [HNPN14 Secs. 5.1, 7]");
                 if s != *source {
                     *source = s;
                     changed = true;
@@ -308,7 +308,7 @@ fn filtering(ui: &mut Ui, f: &mut Filtering) -> bool {
             ui.selectable_value(&mut c, Correlation::Uncorrelated, "Uncorrelated");
         })
         .response
-        .on_hover_text("V̄: height–direction correlated (default) or uncorrelated masking and shadowing [HNPN14 Eq. 12]");
+        .on_hover_text("Mean visibility V: height–direction correlated (default) or uncorrelated masking and shadowing [HNPN14 Eq. 12]");
     if c != f.correlation {
         f.correlation = c;
         changed = true;

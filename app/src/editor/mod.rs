@@ -873,7 +873,7 @@ impl EditorApp {
         egui::Modal::new(egui::Id::unique("unsaved")).show(ctx, |ui| {
             ui.heading("Unsaved changes");
             ui.label(format!(
-                "“{}” has changes that are not saved. Save them first?",
+                "'{}' has changes that are not saved. Save them first?",
                 self.material.name
             ));
             ui.horizontal(|ui| {
@@ -929,7 +929,7 @@ impl EditorApp {
             .unwrap_or_else(|| "untitled".into());
         let title = format!(
             "{}{} — {} — Lodestone",
-            if self.dirty() { "● " } else { "" },
+            if self.dirty() { "* " } else { "" },
             self.material.name,
             file
         );

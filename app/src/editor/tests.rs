@@ -287,3 +287,67 @@ fn exports_every_view_and_error_map_as_png_and_exr() {
     let e = exr.get_pixel(x, y);
     assert!((0..3).all(|k| (e[k] - c[k]).abs() < 1e-6), "{e:?} vs {c:?}");
 }
+
+#[test]
+fn the_baseline_view_switches_in_place() {
+    let mut h = harness(1280.0, 720.0, DeviceSource::Headless);
+    let t0 = Instant::now();
+    while !matches!(h.state().device, DeviceStatus::Ready(_))
+        && t0.elapsed() < Duration::from_secs(60)
+    {
+        if no_adapter(&h) {
+            eprintln!("skipped: no adapter");
+            return;
+        }
+        h.step();
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    assert_eq!(h.state().view.baseline, super::view_state::Mode::Naive);
+    h.step();
+    h.get_by_label("show view-independent").click();
+    h.step();
+    assert_eq!(
+        h.state().view.baseline,
+        super::view_state::Mode::ViewIndependent
+    );
+    h.step();
+    h.get_by_label("show naive MIP").click();
+    h.step();
+    assert_eq!(h.state().view.baseline, super::view_state::Mode::Naive);
+}
+
+/// Every non-ASCII character in the editor's texts (labels and tooltips, which tests do not hover)
+/// has a glyph in the fonts the app ships: kittest panics on a missing glyph.
+#[test]
+fn every_character_of_the_editor_texts_has_a_glyph() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/editor");
+    let mut chars = std::collections::BTreeSet::new();
+    for entry in std::fs::read_dir(&dir).expect("src/editor") {
+        let p = entry.expect("entry").path();
+        if p.file_name().is_some_and(|n| n == "tests.rs") {
+            continue;
+        }
+        let text = std::fs::read_to_string(&p).expect("source");
+        // Characters inside string literals (comment lines skipped).
+        for line in text.lines().filter(|l| !l.trim_start().starts_with("//")) {
+            let mut inside = false;
+            let mut prev = ' ';
+            for c in line.chars() {
+                if c == '"' && prev != '\\' {
+                    inside = !inside;
+                } else if inside && !c.is_ascii() {
+                    chars.insert(c);
+                }
+                prev = c;
+            }
+        }
+    }
+    let all: String = chars.into_iter().collect();
+    assert!(!all.is_empty());
+    let mut h = Harness::builder()
+        .with_size(egui::vec2(600.0, 100.0))
+        .build_ui(move |ui| {
+            ui.label(&all);
+        });
+    h.run();
+}

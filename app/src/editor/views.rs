@@ -193,7 +193,7 @@ impl EditorApp {
                     let mut sweeping = self.sweep.is_some();
                     if ui
                         .toggle_value(&mut sweeping, "Sweep zoom")
-                        .on_hover_text("Animate the distance close → far → back to show the level of detail (W)")
+                        .on_hover_text("Animate the distance close, far and back to show the level of detail (W)")
                         .clicked()
                     {
                         let ctx = ui.ctx().clone();
@@ -333,6 +333,42 @@ impl EditorApp {
             mode.label().to_string()
         };
         self.label_row(ui, label, &title, extra);
+        if matches!(mode, Mode::Naive | Mode::ViewIndependent) {
+            // The baseline switches between naive MIP and view-independent filtering in place.
+            let other = if mode == Mode::Naive {
+                "show view-independent"
+            } else {
+                "show naive MIP"
+            };
+            let title_w = ui
+                .painter()
+                .layout_no_wrap(
+                    title.clone(),
+                    egui::FontId::proportional(14.0),
+                    Color32::WHITE,
+                )
+                .size()
+                .x;
+            let r = Rect::from_min_size(
+                Pos2::new(label.left() + title_w + 14.0, label.top() + 1.0),
+                Vec2::new(170.0, LABEL_H - 2.0),
+            )
+            .intersect(label);
+            if ui
+                .put(
+                    r,
+                    egui::Button::new(other)
+                        .small()
+                        .wrap_mode(egui::TextWrapMode::Extend),
+                )
+                .on_hover_text(
+                    "Switch this view between naive MIP (colour map of the filtered driver) and view-independent texture filtering (the exact footprint average, no masking) (B)",
+                )
+                .clicked()
+            {
+                self.toggle_baseline();
+            }
+        }
         ui.painter().rect_filled(img, 0.0, Color32::from_gray(20));
         let tex = if show_error {
             self.errors.get(&rm).map(|e| e.texture.id())
