@@ -14,7 +14,7 @@
 use crate::brdf::normal_of;
 use crate::camera::{Camera, PIXEL_SIGMA};
 use crate::footprint::{Method, Prepared};
-use crate::surface::RELAXATION;
+use crate::surface::sphere_trace;
 use glam::{DMat2, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
@@ -98,51 +98,18 @@ impl Prepared {
     }
 
     /// March `o + t·d` (unit d, o outside or on the surface) against the displaced cylinder, up to
-    /// `t_max`. Same over-relaxed sphere tracing with back-off as [`crate::surface::march_heightfield`],
-    /// on the gap `ρ − R − h(u, v)`. Returns the last point above the surface at the crossing.
+    /// `t_max`. The shared [`sphere_trace`] on the gap `ρ − R − h(u, v)`. Returns the last point above the surface at the crossing.
     pub fn cylinder_march(&self, r: f64, o: DVec3, d: DVec3, t_max: f64) -> Option<f64> {
         let s = &self.surface;
-        let rate = self.cylinder_rate(r);
-        let gap = |t: f64| {
-            let (u, v, rho, _) = to_surface(r, o + d * t);
-            rho - r - s.height(DVec2::new(u, v))
-        };
-        let (mut t, mut prev_t, mut prev_r) = (0.0_f64, 0.0_f64, 0.0_f64);
-        let mut relaxed = false;
-        for _ in 0..1_000_000 {
-            let mut g = gap(t);
-            if g < 0.0 && t == 0.0 {
-                g = 0.0;
-            }
-            let rr = g.max(0.0) / rate;
-            if relaxed && t - prev_t > prev_r + rr {
-                t = prev_t + prev_r.max(s.min_step);
-                relaxed = false;
-                continue;
-            }
-            if t > t_max {
-                return None;
-            }
-            if g < 0.0 {
-                let (mut a, mut b) = (prev_t, t);
-                for _ in 0..48 {
-                    let m = 0.5 * (a + b);
-                    if gap(m) >= 0.0 {
-                        a = m;
-                    } else {
-                        b = m;
-                    }
-                }
-                return Some(a);
-            }
-            prev_t = t;
-            prev_r = rr;
-            let safe = rr.max(s.min_step);
-            let step = (RELAXATION * rr).max(s.min_step);
-            relaxed = step > safe;
-            t += step;
-        }
-        None
+        sphere_trace(
+            |t| {
+                let (u, v, rho, _) = to_surface(r, o + d * t);
+                rho - r - s.height(DVec2::new(u, v))
+            },
+            self.cylinder_rate(r),
+            s.min_step,
+            |t| t > t_max,
+        )
     }
 
     /// Ground-truth radiance along a camera ray toward light ωi, for the cylinder of radius `r`:

@@ -144,18 +144,38 @@ pub fn march_heightfield(
     min_step: f64,
     height: impl Fn(DVec2) -> f64,
 ) -> Option<f64> {
+    let top = h_max * (1.0 + 1e-12) + 1e-300;
+    sphere_trace(
+        |t| {
+            let p = o + d * t;
+            p.z - height(DVec2::new(p.x, p.y))
+        },
+        rate,
+        min_step,
+        |t| {
+            let z = o.z + d.z * t;
+            (d.z >= 0.0 && z > top) || (d.z < 0.0 && z < -top - 1.0)
+        },
+    )
+}
+
+/// The over-relaxed sphere tracing shared by every surface: `gap(t)` is the signed distance-like
+/// gap along the ray (≥ 0 outside), `rate` a bound on |d gap/dt|, `left(t)` says the ray has left
+/// the region where the surface can be. Rules as in [`march_heightfield`]: relaxed steps back off
+/// when the safe intervals do not cover them, steps are at least `min_step`, a sign change is refined
+/// by 48 bisections (returning the last point above), a negative gap at t = 0 is rounding.
+pub fn sphere_trace(
+    gap: impl Fn(f64) -> f64,
+    rate: f64,
+    min_step: f64,
+    left: impl Fn(f64) -> bool,
+) -> Option<f64> {
     if !(rate > 0.0) {
         return None;
     }
-    let top = h_max * (1.0 + 1e-12) + 1e-300;
-    let gap = |t: f64| {
-        let p = o + d * t;
-        p.z - height(DVec2::new(p.x, p.y))
-    };
     let (mut t, mut prev_t, mut prev_r) = (0.0_f64, 0.0_f64, 0.0_f64);
     let mut relaxed = false;
     for _ in 0..1_000_000 {
-        let p = o + d * t;
         let mut g = gap(t);
         if g < 0.0 && t == 0.0 {
             g = 0.0;
@@ -167,7 +187,7 @@ pub fn march_heightfield(
             relaxed = false;
             continue;
         }
-        if (d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0) {
+        if left(t) {
             return None;
         }
         if g < 0.0 {

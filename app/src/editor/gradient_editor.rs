@@ -31,6 +31,15 @@ pub fn builtin(name: &str, lo: f64, hi: f64) -> Option<Gradient> {
 /// Names of the built-in maps.
 pub const BUILTINS: [&str; 3] = ["viridis", "terrain", "rust"];
 
+/// Move stop `i` to `pos`, keeping the stops sorted; returns its new index.
+fn move_stop(g: &mut Gradient, i: usize, pos: f64) -> usize {
+    let mut stop = g.stops.remove(i);
+    stop.position = pos;
+    let at = g.stops.partition_point(|s| s.position <= pos);
+    g.stops.insert(at, stop);
+    at
+}
+
 /// Height of the bar in points.
 const BAR_HEIGHT: f32 = 26.0;
 /// Size of a stop handle.
@@ -135,11 +144,7 @@ impl GradientEditor {
         if let Some((i, pos)) = moved
             && pos.is_finite()
         {
-            let mut stop = g.stops.remove(i);
-            stop.position = pos;
-            let at = g.stops.partition_point(|s| s.position <= pos);
-            g.stops.insert(at, stop);
-            self.selected = at;
+            self.selected = move_stop(g, i, pos);
             changed = true;
         }
         // The selected stop.
@@ -162,11 +167,7 @@ impl GradientEditor {
                     .labelled_by(l.id)
                     .on_hover_text("Position of the selected stop along the mapped value (f or standardized height)");
                 if r.changed() && pos.is_finite() {
-                    let mut stop = g.stops.remove(i);
-                    stop.position = pos;
-                    let at = g.stops.partition_point(|s| s.position <= pos);
-                    g.stops.insert(at, stop);
-                    self.selected = at;
+                    self.selected = move_stop(g, i, pos);
                     changed = true;
                 }
             }
