@@ -106,6 +106,37 @@ pub enum Command {
     Show,
     /// Describe the GPU adapter wgpu finds; exit code 3 when there is none.
     Adapter,
+    /// Error against run time: naive, view-independent, both filtered variants and ground truth at
+    /// 1…256 rays against a ground-truth reference over view/light configurations and zoom levels;
+    /// writes report.json, report.md and SVG charts into --out.
+    Report {
+        /// Output folder.
+        #[arg(long)]
+        out: std::path::PathBuf,
+        /// Image size WIDTHxHEIGHT of every rendering.
+        #[arg(long, default_value = "64x40", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Rays per pixel of the reference.
+        #[arg(long, default_value_t = 1024)]
+        reference_spp: u32,
+        /// View angles from the normal, degrees (comma-separated).
+        #[arg(long, default_value = "0,30,60,75,85,89", value_delimiter = ',')]
+        views: Vec<f64>,
+        /// Camera distances, one per zoom level (comma-separated).
+        #[arg(long, default_value = "1.5,6,40", value_delimiter = ',')]
+        zooms: Vec<f64>,
+        /// Timing repeats (the median is reported).
+        #[arg(long, default_value_t = 5)]
+        repeats: u32,
+    },
+    /// Run stiff and extreme cases (grazing angles, σ → 0 and 1e6, anisotropy 1e±6, L to 1e12, step
+    /// maps, vertical transfer segments, constant images) through core f64, its f32 mirror and the
+    /// WGSL; exit code 1 if any output is non-finite or exceeds its documented bound.
+    Stability {
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 /// What `render` draws.

@@ -1,8 +1,8 @@
 //! `lodestone eval`: the CPU reference evaluation of a far patch under every method.
 
+use crate::preset_io::Resolved;
 use anyhow::Result;
-use lodestone_core::footprint::{Config, Prepared};
-use lodestone_core::material::Material;
+use lodestone_core::footprint::Config;
 use lodestone_core::smith::direction;
 use serde::Serialize;
 
@@ -47,9 +47,10 @@ pub struct RelativeErrors {
 }
 
 /// Evaluate the far patch.
-pub fn eval(material: &Material, angles: [f64; 4], samples: usize) -> Result<EvalReport> {
+pub fn eval(preset: &Resolved, angles: [f64; 4], samples: usize) -> Result<EvalReport> {
+    let material = &preset.material;
     let [view_deg, view_azimuth_deg, light_deg, light_azimuth_deg] = angles;
-    let prepared = Prepared::new(material)?;
+    let prepared = preset.prepare()?;
     let wo = direction(
         view_deg.clamp(0.0, 89.5).to_radians(),
         view_azimuth_deg.to_radians(),

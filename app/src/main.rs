@@ -8,6 +8,8 @@ mod editor;
 mod eval;
 mod preset_io;
 mod render_cmd;
+mod report;
+mod stability;
 
 use anyhow::{Context, Result};
 use clap::Parser;
@@ -45,10 +47,12 @@ fn exit_code(e: &anyhow::Error) -> u8 {
 }
 
 /// Load a preset (or the built-in default), naming the file in any error.
-fn load(path: Option<&Path>) -> Result<Material> {
+fn load(path: Option<&Path>) -> Result<preset_io::Resolved> {
     match path {
-        None => Material::from_ron(preset_io::DEFAULT_PRESET).context("built-in default preset"),
-        Some(p) => Ok(preset_io::load(p)?),
+        None => Ok(preset_io::Resolved::without_image(
+            Material::from_ron(preset_io::DEFAULT_PRESET).context("built-in default preset")?,
+        )),
+        Some(p) => Ok(preset_io::load_resolved(p)?),
     }
 }
 
@@ -75,7 +79,8 @@ fn run_editor(preset: Option<(std::path::PathBuf, Material)>) -> Result<()> {
 }
 
 fn run(cli: Cli) -> Result<()> {
-    let material = load(cli.preset.as_deref())?;
+    let preset = load(cli.preset.as_deref())?;
+    let material = &preset.material;
     match cli.command {
         None => run_editor(cli.preset.clone().map(|p| (p, material.clone())))?,
         Some(Command::Eval {
@@ -87,7 +92,7 @@ fn run(cli: Cli) -> Result<()> {
             json,
         }) => {
             let r = eval::eval(
-                &material,
+                &preset,
                 [view_deg, view_azimuth_deg, light_deg, light_azimuth_deg],
                 spp,
             )?;
@@ -128,13 +133,13 @@ fn run(cli: Cli) -> Result<()> {
                 distance,
                 shape,
             };
-            render_cmd::render(&material, view, mode, size, spp, &out, formats)?;
+            render_cmd::render(&preset, view, mode, size, spp, &out, formats)?;
         }
         Some(Command::Bench { size, frames, json }) => {
-            render_cmd::bench(&material, size, frames, json)?
+            render_cmd::bench(&preset, size, frames, json)?
         }
         Some(Command::Export { out }) => {
-            let written = preset_io::export_bundle(&material, &out)?;
+            let written = preset_io::export_bundle(&preset, &out)?;
             println!(
                 "wrote {} files to {} (see manifest.json)",
                 written.len(),
@@ -143,6 +148,30 @@ fn run(cli: Cli) -> Result<()> {
         }
         Some(Command::Validate) => println!("ok: {} is a valid preset", material.name),
         Some(Command::Show) => println!("{}", material.to_ron()),
+        Some(Command::Stability { json }) => stability::run(json)?,
+        Some(Command::Report {
+            out,
+            size,
+            reference_spp,
+            views,
+            zooms,
+            repeats,
+        }) => {
+            let opts = report::Options {
+                size,
+                reference_spp,
+                views,
+                zooms,
+                repeats,
+            };
+            let rep = report::run(&preset, &opts)?;
+            report::write(&rep, &out)?;
+            print!("{}", report::markdown(&rep));
+            println!(
+                "wrote report.json, report.md, error_vs_time.svg, error_vs_view.svg to {}",
+                out.display()
+            );
+        }
         Some(Command::Adapter) => {
             let ctx = lodestone_render::GpuContext::new_headless()?;
             println!("{}", ctx.describe());

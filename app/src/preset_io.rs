@@ -3,10 +3,12 @@
 //! Saves are atomic: the text goes to a temporary file beside the target, is flushed to disk, then
 //! renamed over the target, so a crash mid-save never leaves a truncated preset.
 
+use lodestone_core::footprint::{PrepareError, Prepared};
 use lodestone_core::image_driver::ImageDriver;
 use lodestone_core::material::{Driver, Material, MaterialError};
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// The built-in default preset.
 pub const DEFAULT_PRESET: &str = include_str!("../../presets/default.ron");
@@ -58,19 +60,60 @@ pub fn default_material() -> Material {
 
 /// Load and validate a preset file.
 pub fn load(path: &Path) -> Result<Material, PresetError> {
+    load_resolved(path).map(|r| r.material)
+}
+
+/// A material together with the decoded image its driver needs (none for a noise driver).
+#[derive(Clone, Debug)]
+pub struct Resolved {
+    /// The material.
+    pub material: Material,
+    /// The driver image, decoded and mip-mapped.
+    pub image: Option<Arc<ImageDriver>>,
+}
+
+impl Resolved {
+    /// A material whose driver needs no file (an image driver's image stays unloaded).
+    pub fn without_image(material: Material) -> Self {
+        Self {
+            material,
+            image: None,
+        }
+    }
+
+    /// The material's tables and surface, ready for the CPU reference and the GPU.
+    pub fn prepare(&self) -> Result<Prepared, PrepareError> {
+        Prepared::with_image(&self.material, self.image.clone(), None)
+    }
+}
+
+/// Load a preset and, for an image driver, its image (resolved against the preset's folder).
+pub fn load_resolved(path: &Path) -> Result<Resolved, PresetError> {
     let text = std::fs::read_to_string(path).map_err(|error| PresetError::Read {
         path: path.to_owned(),
         error,
     })?;
-    let m = Material::from_ron(&text).map_err(|error| PresetError::Material {
+    let material = Material::from_ron(&text).map_err(|error| PresetError::Material {
         path: path.to_owned(),
         error,
     })?;
-    if let Driver::Image { path: image, .. } = &m.driver {
-        let dir = path.parent().unwrap_or(Path::new("."));
-        load_image_driver(path, &dir.join(image))?;
-    }
-    Ok(m)
+    let image = driver_image(&material, Some(path))?;
+    Ok(Resolved { material, image })
+}
+
+/// The image of `material`'s driver, its path taken relative to the folder of `preset` (the
+/// current directory when there is no preset file); `None` for a noise driver.
+pub fn driver_image(
+    material: &Material,
+    preset: Option<&Path>,
+) -> Result<Option<Arc<ImageDriver>>, PresetError> {
+    let Driver::Image { path: image, .. } = &material.driver else {
+        return Ok(None);
+    };
+    let dir = preset.and_then(|p| p.parent()).unwrap_or(Path::new("."));
+    let full = dir.join(image);
+    load_image_driver(preset.unwrap_or(Path::new("(unsaved material)")), &full)
+        .map(|d| Some(Arc::new(d)))
 }
 
 /// Load and check a driver image: it must exist, decode, fit [`ImageDriver::MAX_SIDE`] (checked
@@ -121,9 +164,9 @@ pub fn write_atomic(path: &Path, text: &str) -> Result<(), PresetError> {
 }
 
 /// Write the engine bundle of `m` into `dir` (created if needed); returns the files written.
-pub fn export_bundle(m: &Material, dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
+pub fn export_bundle(m: &Resolved, dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
     use anyhow::Context;
-    let prepared = lodestone_core::footprint::Prepared::new(m)?;
+    let prepared = m.prepare()?;
     let files = lodestone_render::export::bundle(&prepared)?;
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let mut written = Vec::new();

@@ -1,11 +1,10 @@
 //! `lodestone render` and `lodestone bench`: headless GPU work.
 
 use crate::cli::{Formats, RenderMode};
+use crate::preset_io::Resolved;
 use anyhow::{Context, Result, bail};
 use lodestone_core::camera::Camera;
 use lodestone_core::cylinder::Shape;
-use lodestone_core::footprint::Prepared;
-use lodestone_core::material::Material;
 use lodestone_core::smith::direction;
 use lodestone_render::error_map::{abs_difference, error_stats, heat_map};
 use lodestone_render::{
@@ -84,7 +83,7 @@ fn renderer() -> Result<Renderer> {
 
 /// `lodestone render`.
 pub fn render(
-    material: &Material,
+    preset: &Resolved,
     view: View,
     mode: RenderMode,
     size: (u32, u32),
@@ -92,7 +91,7 @@ pub fn render(
     out: &Path,
     formats: Formats,
 ) -> Result<()> {
-    let prepared = Prepared::new(material)?;
+    let prepared = preset.prepare()?;
     let r = renderer()?;
     let scene = view.scene();
     let gm = GpuMaterial::new(r.context(), &prepared, scene.camera.target);
@@ -163,8 +162,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 }
 
 /// `lodestone bench`.
-pub fn bench(material: &Material, size: (u32, u32), frames: u32, json: bool) -> Result<()> {
-    let prepared = Prepared::new(material)?;
+pub fn bench(preset: &Resolved, size: (u32, u32), frames: u32, json: bool) -> Result<()> {
+    let prepared = preset.prepare()?;
     let r = renderer()?;
     let scene = View {
         view_deg: 60.0,

@@ -134,3 +134,89 @@ fn export_writes_the_engine_bundle() {
         serde_json::from_str(&std::fs::read_to_string(dir.join("manifest.json")).unwrap()).unwrap();
     assert_eq!(manifest["material"], "Moss clumps (transfer function)");
 }
+
+/// `lodestone stability --json`: every row is finite and within its bound, and the exit code says so.
+#[test]
+fn stability_passes_and_reports_json() {
+    let out = lodestone(&["stability", "--json"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}\n{text}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+    let rows = rows.as_array().expect("an array of rows");
+    assert!(rows.len() >= 29, "{} rows", rows.len());
+    for r in rows {
+        assert_eq!(r["non_finite"], 0, "{r}");
+        assert!(
+            r["max_deviation"].as_f64().unwrap() <= r["bound"].as_f64().unwrap(),
+            "{r}"
+        );
+    }
+    for path in ["CoreF64", "CoreF32"] {
+        assert!(rows.iter().any(|r| r["path"] == path), "no {path} rows");
+    }
+}
+
+/// `lodestone report` with a tiny budget: every file is written, every configuration and method is
+/// there with finite numbers, and ground truth's error falls as its rays grow.
+#[test]
+fn report_writes_tables_and_charts() {
+    let dir = std::env::temp_dir().join(format!("lodestone-report-{}", std::process::id()));
+    let out = lodestone(&[
+        "report",
+        "--out",
+        dir.to_str().unwrap(),
+        "--size",
+        "12x8",
+        "--reference-spp",
+        "16",
+        "--views",
+        "0,60",
+        "--zooms",
+        "6",
+        "--repeats",
+        "1",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "report.json",
+        "report.md",
+        "error_vs_time.svg",
+        "error_vs_view.svg",
+    ] {
+        assert!(dir.join(f).is_file(), "{f} missing");
+    }
+    let rep: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+    let configs = rep["configs"].as_array().unwrap();
+    assert_eq!(configs.len(), 2 * 3);
+    for c in configs {
+        let methods = c["methods"].as_array().unwrap();
+        // Four analytic methods and ground truth at 1 and 4 rays (16 is the reference itself).
+        assert_eq!(methods.len(), 6, "{c}");
+        for m in methods {
+            for k in ["rmse", "delta_e_mean", "delta_e_p95", "ms"] {
+                assert!(m[k].as_f64().unwrap().is_finite(), "{m}");
+            }
+        }
+        let rmse = |name: &str| {
+            methods.iter().find(|m| m["method"] == name).unwrap()["rmse"]
+                .as_f64()
+                .unwrap()
+        };
+        assert!(
+            rmse("ground truth 4 spp") < rmse("ground truth 1 spp"),
+            "{c}"
+        );
+    }
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    assert!(md.contains("| naive MIP |") && md.contains("ref. noise"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,7 +1,7 @@
 //! Print one of the generated presets of the library as RON (the curves of these come from code, so
 //! the files are regenerated rather than hand-edited):
 //! `cargo run -p lodestone-core --example library -- NAME > presets/NAME.ron`
-//! for NAME in sponge, terraces, bumpy-specular, colormapped-noise.
+//! for NAME in sponge, terraces, bumpy-specular, colormapped-noise, cobblestones.
 
 use lodestone_core::brdf::BaseBrdf;
 use lodestone_core::colormap::{ColorStop, Gradient, Interpolation};
@@ -159,6 +159,61 @@ fn preset(name: &str) -> Option<(&'static str, Material)> {
                 ..base
             },
         ),
+        "cobblestones" => (
+            "Cobblestones [HNPN14 Fig. 6]: explicit, non-Gaussian data (an image driver: flat-topped stones, a \
+             tail of mortar; skewness -0.27, excess kurtosis -0.78) filtered with the Gaussian approximation. \
+             The image is written by `cargo run -p lodestone --example cobblestones`.",
+            Material {
+                name: "Cobblestones (image driver)".into(),
+                driver: Driver::Image {
+                    path: "images/cobblestones.png".into(),
+                    size: 1.0,
+                },
+                heights: Heights {
+                    sigma_h: 0.004,
+                    transfer: TransferFunction::Identity,
+                },
+                // Image drivers take their slopes from the image; these are not used.
+                slopes: Slopes {
+                    sigma_nx: 0.3,
+                    sigma_ny: 0.3,
+                },
+                color: ColorModel::Gradient {
+                    map: Gradient {
+                        stops: vec![
+                            ColorStop {
+                                position: -3.0,
+                                color: [0.03, 0.025, 0.02],
+                            },
+                            ColorStop {
+                                position: -1.6,
+                                color: [0.09, 0.07, 0.05],
+                            },
+                            ColorStop {
+                                position: -0.9,
+                                color: [0.35, 0.3, 0.24],
+                            },
+                            ColorStop {
+                                position: 0.3,
+                                color: [0.5, 0.46, 0.4],
+                            },
+                            ColorStop {
+                                position: 1.4,
+                                color: [0.75, 0.68, 0.55],
+                            },
+                        ],
+                        interpolation: Interpolation::Linear,
+                    },
+                    source: ColorSource::Driver,
+                },
+                brdf: BaseBrdf {
+                    albedo: 1.0,
+                    specular: 0.04,
+                    roughness: 0.25,
+                },
+                ..base
+            },
+        ),
         _ => return None,
     })
 }
@@ -174,7 +229,9 @@ fn main() {
             println!("{}", m.to_ron());
         }
         None => {
-            eprintln!("usage: library sponge|terraces|bumpy-specular|colormapped-noise");
+            eprintln!(
+                "usage: library sponge|terraces|bumpy-specular|colormapped-noise|cobblestones"
+            );
             std::process::exit(2);
         }
     }

@@ -11,8 +11,10 @@
 pub mod attribute;
 pub mod brdf;
 pub mod camera;
+pub mod cielab;
 pub mod colormap;
 pub mod cylinder;
+pub mod driver_field;
 pub mod effective_height;
 pub mod footprint;
 pub mod image_driver;
@@ -26,6 +28,7 @@ pub mod slopes;
 pub mod smith;
 pub mod special;
 pub mod special_f32;
+pub mod stability;
 pub mod surface;
 pub mod transfer;
 pub mod validation;

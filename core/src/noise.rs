@@ -170,10 +170,7 @@ impl SumOfSines {
         let mut me = Self { waves };
         // Exact gradient covariance: k ↦ T^{1/2} G^{−1/2} k.
         let target = {
-            let t = DMat2::from_cols(
-                DVec2::new(grad_cov.xx, grad_cov.xy),
-                DVec2::new(grad_cov.xy, grad_cov.yy),
-            );
+            let t = grad_cov.to_mat();
             let ok = t.x_axis.x.is_finite() && t.y_axis.y.is_finite() && t.x_axis.y.is_finite();
             if ok && t.x_axis.x + t.y_axis.y > 0.0 {
                 t
@@ -255,11 +252,7 @@ impl SumOfSines {
             mean,
             std: var.max(0.0).sqrt(),
             mean_gradient: grad,
-            gradient_cov: SlopeCov {
-                xx: cov.x_axis.x,
-                yy: cov.y_axis.y,
-                xy: cov.x_axis.y,
-            },
+            gradient_cov: SlopeCov::from_mat(cov),
         }
     }
 
@@ -278,12 +271,7 @@ impl SumOfSines {
 
     /// The gradient covariance of the unfiltered noise (equals the construction target).
     pub fn gradient_cov(&self) -> SlopeCov {
-        let m = self.gradient_cov_matrix(Footprint::point());
-        SlopeCov {
-            xx: m.x_axis.x,
-            yy: m.y_axis.y,
-            xy: m.x_axis.y,
-        }
+        SlopeCov::from_mat(self.gradient_cov_matrix(Footprint::point()))
     }
 }
 

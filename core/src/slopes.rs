@@ -64,6 +64,23 @@ impl SlopeCov {
         v.max(0.0).sqrt()
     }
 
+    /// The covariance as a symmetric 2×2 matrix.
+    pub fn to_mat(self) -> glam::DMat2 {
+        glam::DMat2::from_cols(
+            glam::DVec2::new(self.xx, self.xy),
+            glam::DVec2::new(self.xy, self.yy),
+        )
+    }
+
+    /// From a 2×2 matrix: its diagonal and the mean of its off-diagonal entries (the symmetric part).
+    pub fn from_mat(m: glam::DMat2) -> Self {
+        Self {
+            xx: m.x_axis.x,
+            yy: m.y_axis.y,
+            xy: 0.5 * (m.x_axis.y + m.y_axis.x),
+        }
+    }
+
     /// Determinant `xx·yy − xy²` (≥ 0 for a valid covariance).
     pub fn det(&self) -> f64 {
         self.xx * self.yy - self.xy * self.xy

@@ -110,9 +110,10 @@ pub fn norm_cdf(z: f32) -> f32 {
 /// ln Φ(z); finite for every finite z (uses erfcx below z = −3; `ln(1 − Q)` by its series for small Q).
 pub fn log_norm_cdf(z: f32) -> f32 {
     if z < -3.0 {
-        let x = -z * std::f32::consts::FRAC_1_SQRT_2;
-        let v = (0.5 * erfcx(x)).ln() - x * x;
-        if v.is_finite() { v } else { f32::MIN }
+        // x² overflows f32 beyond x ≈ 1.8e19: the argument is bounded there (as in the WGSL, which
+        // cannot test for infinity reliably) and the result saturates at f32::MIN.
+        let x = (-z * std::f32::consts::FRAC_1_SQRT_2).min(1.8e19);
+        ((0.5 * erfcx(x)).ln() - x * x).max(f32::MIN)
     } else if z < 0.0 {
         norm_cdf(z).ln()
     } else {

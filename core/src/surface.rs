@@ -1,25 +1,27 @@
-//! The explicit micro-geometry `h(x) = σ_h·g(f(x))` of a noise-driven material, and ray marching on
-//! it that cannot step over a feature. This is what the ground truth renders: no statistics here.
+//! The explicit micro-geometry `h(x) = σ_h·g(f(x))` of a material (noise- or image-driven, see
+//! [`DriverField`]), and ray marching on it that cannot step over a feature. This is what the ground
+//! truth renders: no statistics here.
 //!
 //! Step rule (sphere tracing for heightfields, design.md): along a ray `p(t) = o + t·d`, the gap
 //! `z(t) − h(x(t))` changes at most at rate `|d_z| + K_d |d_xy|`, where
-//! `K_d = σ_h · max|g′| · Σ|a_i| 2π |k_i·d̂_xy|` bounds the slope of h along the ray's horizontal
-//! direction. So the step `Δt = gap/(|d_z| + K_d|d_xy|)` can never cross the surface. To bound the
-//! work where a ray skims the surface, steps are at least `Δ_min = 1e-4 × (shortest wavelength)`;
+//! `K_d = σ_h · max|g′| · L_f(d̂_xy)` bounds the slope of h along the ray's horizontal direction
+//! (`L_f = Σ|a_i| 2π |k_i·d̂|` for the noise, the texel differences for an image,
+//! [`DriverField::lipschitz_along`]). So the step `Δt = gap/(|d_z| + K_d|d_xy|)` can never cross the surface. To bound the
+//! work where a ray skims the surface, steps are at least `Δ_min = 1e-4 × (shortest wavelength or texel)`;
 //! a sign change of the gap is then refined by 48 bisections. A feature can be missed only if it
 //! pokes through the ray over less than Δ_min (≈ 1e-4 of the finest wavelength), i.e. never in
 //! practice. Rays stop once above `h_max = σ_h·max|g|` (rigorous bound).
 
+use crate::driver_field::DriverField;
 use crate::material::Material;
-use crate::noise::SumOfSines;
 use crate::transfer::TransferFunction;
 use glam::{DVec2, DVec3};
 
-/// The explicit heightfield of a noise-driven material.
+/// The explicit heightfield of a material.
 #[derive(Clone, Debug)]
 pub struct Surface {
-    /// The driver realisation.
-    pub noise: SumOfSines,
+    /// The driver.
+    pub driver: DriverField,
     /// σ_h.
     pub sigma_h: f64,
     /// g.
@@ -42,36 +44,43 @@ pub enum Trace {
 }
 
 impl Surface {
-    /// The surface of a noise-driven material (`None` for an image driver).
+    /// The surface of a noise-driven material (`None` for an image driver, which needs its image:
+    /// [`Surface::with_driver`]).
     pub fn new(material: &Material) -> Option<Self> {
-        let noise = material.noise()?;
+        Some(Self::with_driver(
+            material,
+            DriverField::Noise(material.noise()?),
+        ))
+    }
+
+    /// The surface of `material` driven by `driver`.
+    pub fn with_driver(material: &Material, driver: DriverField) -> Self {
         let sigma_h = material.heights.sigma_h.max(0.0);
         let transfer = material.heights.transfer.clone();
-        let a = noise.amplitude_bound();
+        let a = driver.amplitude_bound();
         let g_abs_max = match &transfer {
             TransferFunction::Identity => a,
             TransferFunction::Curve(c) => c.points.iter().map(|p| p[1].abs()).fold(0.0, f64::max),
         };
-        let k_max = noise.waves.iter().map(|w| w.k.length()).fold(0.0, f64::max);
-        let min_step = if k_max > 0.0 { 1e-4 / k_max } else { 1e-6 };
-        Some(Self {
+        let min_step = 1e-4 * driver.finest_scale();
+        Self {
             g_lip: transfer.max_derivative(),
-            noise,
+            driver,
             sigma_h,
             transfer,
             h_max: sigma_h * g_abs_max,
             min_step,
-        })
+        }
     }
 
     /// h(x).
     pub fn height(&self, x: DVec2) -> f64 {
-        self.sigma_h * self.transfer.eval(self.noise.value(x))
+        self.sigma_h * self.transfer.eval(self.driver.value(x))
     }
 
     /// f(x), h(x) and ∇h(x) = σ_h g′(f) ∇f.
     pub fn sample(&self, x: DVec2) -> (f64, f64, DVec2) {
-        let (f, gf) = self.noise.value_and_gradient(x);
+        let (f, gf) = self.driver.value_and_gradient(x);
         let (g, gd) = match &self.transfer {
             TransferFunction::Identity => (f, 1.0),
             t => (t.eval(f), t.derivative(f)),
@@ -81,18 +90,12 @@ impl Surface {
 
     /// Lipschitz constant of h along the horizontal unit direction `dir`.
     pub fn lipschitz_along(&self, dir: DVec2) -> f64 {
-        self.sigma_h * self.g_lip * self.noise.lipschitz_along(dir)
+        self.sigma_h * self.g_lip * self.driver.lipschitz_along(dir)
     }
 
-    /// A bound of |∇h| in every direction: σ_h·max|g′|·Σ|a_i|·2π|k_i|.
+    /// A bound of |∇h| in every direction: σ_h·max|g′|·max|∇f| ([`DriverField::gradient_bound`]).
     pub fn slope_bound(&self) -> f64 {
-        let n: f64 = self
-            .noise
-            .waves
-            .iter()
-            .map(|w| w.amplitude.abs() * std::f64::consts::TAU * w.k.length())
-            .sum();
-        self.sigma_h * self.g_lip * n
+        self.sigma_h * self.g_lip * self.driver.gradient_bound()
     }
 
     /// March `p(t) = o + t·d` (d unit) from t = 0 while it is above the surface; `Hit(t)` at the first

@@ -76,9 +76,10 @@ pub fn snippet_wgsl() -> String {
     format!(
         "// Lodestone filtered material, self-contained WGSL (lodestone-core mirrored in f32).\n\
          // Bindings: 0 = Params (params.bin), 1 = data (data.bin); see manifest.json.\n\
-         // API: eval_filtered / eval_naive / eval_view_independent(x0, fp, wo, wi) -> vec3<f32>.\n\n{}\n{}\n{}",
+         // API: eval_filtered / eval_naive / eval_view_independent(x0, fp, wo, wi) -> vec3<f32>.\n\n{}\n{}\n{}\n{}",
         shaders::SPECIAL,
         shaders::MATERIAL,
+        shaders::IMAGE_DRIVER,
         EXAMPLE
     )
 }
@@ -246,6 +247,23 @@ pub fn bundle(prepared: &Prepared) -> Result<Vec<(String, Vec<u8>)>, ExportError
             "indexing": "texel i holds the moments at ln L = ln_l_min + i·(ln_l_max − ln_l_min)/(size − 1) [HNPN14 Sec. 5.1]",
         }),
     );
+    if let Some(t) = prepared.surface.driver.image() {
+        let (w, h) = t.image.size();
+        tables.insert(
+            "image_driver".into(),
+            json!({
+                "size": [w, h],
+                "levels": t.image.levels.len(),
+                "tile_world_width": t.size,
+                "level_table_offset_floats": params.image_offset,
+                "layout": "at level_table_offset, per level 5 slots: value offset, grad offset, width, height \
+                           (u32 bits), mean variance (f32); the value grid holds (f̄, f²‾) per texel, the cell grid \
+                           (f_x, f_y, f_x², f_y², f_x·f_y) per texel, half a texel after the value grid [HNPN14 Sec. 4.2]",
+                "coordinates": "texel = (image_u0, image_v0) + x·image_scale for x relative to the target the \
+                                bundle was made for (the origin); tiles wrap",
+            }),
+        );
+    }
     let bytes = bytemuck::bytes_of(&params);
     let fields: serde_json::Map<String, serde_json::Value> = gpu_params_offsets()
         .into_iter()

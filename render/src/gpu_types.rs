@@ -62,6 +62,14 @@ pub struct GpuParams {
     pub dh_offset: u32,
     pub radius: f32,
     pub slope_bound: f32,
+    pub driver_kind: u32,
+    pub image_offset: u32,
+    pub image_levels: u32,
+    pub image_scale: f32,
+    pub image_u0: f32,
+    pub image_v0: f32,
+    pub image_lip_x: f32,
+    pub image_lip_y: f32,
 }
 
 /// Field names and byte offsets of [`GpuParams`], in declaration order (for the layout test).
@@ -123,6 +131,14 @@ pub fn gpu_params_offsets() -> Vec<(&'static str, usize)> {
         waves_offset,
         dh_offset,
         radius,
-        slope_bound
+        slope_bound,
+        driver_kind,
+        image_offset,
+        image_levels,
+        image_scale,
+        image_u0,
+        image_v0,
+        image_lip_x,
+        image_lip_y
     )
 }

@@ -8,6 +8,7 @@ use glam::DVec3;
 use lodestone_core::camera::{Camera, PIXEL_SIGMA};
 use lodestone_core::colormap::linear_to_srgb;
 use lodestone_core::cylinder::Shape;
+use lodestone_core::driver_field::{DriverField, TiledImage};
 use lodestone_core::effective_height::{EffectiveHeightTable, HeightFilter};
 use lodestone_core::footprint::{Prepared, hermite_rule};
 use lodestone_core::material::{ColorModel, ColorSource};
@@ -222,6 +223,7 @@ pub fn view_source() -> String {
     [
         shaders::SPECIAL,
         shaders::MATERIAL,
+        shaders::IMAGE_DRIVER,
         shaders::CYLINDER,
         shaders::VIEW,
     ]
@@ -249,7 +251,41 @@ fn push_poly(data: &mut Vec<f32>, p: &PiecewisePoly, channels: &[usize]) -> u32 
     off
 }
 
-/// The material's data buffer (waves, tables, D_h, quadrature rule, curve polynomials, as f32) and
+/// The image pyramid: per level the value grid (f̄, f²‾) and the cell grid (f_x, f_y, f_x², f_y²,
+/// f_x·f_y), then a level table of 5 slots per level (value offset, grad offset, width, height as
+/// u32 bits; mean variance as f32). The target is folded into the texel origin in f64.
+fn push_image(data: &mut Vec<f32>, base: &mut GpuParams, tiled: &TiledImage, target: [f64; 2]) {
+    let img = &tiled.image;
+    let mut offsets = Vec::with_capacity(img.levels.len());
+    for l in &img.levels {
+        let v = data.len() as u32;
+        data.extend(l.value.iter().flatten());
+        let g = data.len() as u32;
+        data.extend(l.grad.iter().flatten());
+        offsets.push((v, g));
+    }
+    base.image_offset = data.len() as u32;
+    for (l, (v, g)) in img.levels.iter().zip(offsets) {
+        data.extend([
+            f32::from_bits(v),
+            f32::from_bits(g),
+            f32::from_bits(l.width as u32),
+            f32::from_bits(l.height as u32),
+            l.mean_variance as f32,
+        ]);
+    }
+    let scale = tiled.texels_per_unit();
+    let (w, h) = img.size();
+    base.driver_kind = 1;
+    base.image_levels = img.levels.len() as u32;
+    base.image_scale = scale as f32;
+    base.image_u0 = (target[0] * scale).rem_euclid(w as f64) as f32;
+    base.image_v0 = (target[1] * scale).rem_euclid(h as f64) as f32;
+    base.image_lip_x = img.lipschitz.x as f32;
+    base.image_lip_y = img.lipschitz.y as f32;
+}
+
+/// The material's data buffer (waves, image pyramid, tables, D_h, quadrature rule, curve polynomials, as f32) and
 /// the material part of the WGSL `Params`, with coordinates relative to `target`: each wave's phase
 /// absorbs 2π k·target in f64, so f32 phases stay accurate anywhere on the plane. Shared by the
 /// renderer and the engine bundle ([`crate::export`]).
@@ -261,14 +297,18 @@ pub fn material_data(prepared: &Prepared, target: [f64; 2]) -> (Vec<f32>, GpuPar
         waves: 0,
         ..Layout::default()
     };
-    for w in &s.noise.waves {
-        let phase = (w.phase + TAU * (w.k.x * target[0] + w.k.y * target[1])).rem_euclid(TAU);
-        data.extend([w.k.x as f32, w.k.y as f32, w.amplitude as f32, phase as f32]);
+    let mut base = GpuParams::default();
+    match &s.driver {
+        DriverField::Noise(noise) => {
+            for w in &noise.waves {
+                let phase =
+                    (w.phase + TAU * (w.k.x * target[0] + w.k.y * target[1])).rem_euclid(TAU);
+                data.extend([w.k.x as f32, w.k.y as f32, w.amplitude as f32, phase as f32]);
+            }
+            base.wave_count = noise.waves.len() as u32;
+        }
+        DriverField::Image(tiled) => push_image(&mut data, &mut base, tiled, target),
     }
-    let mut base = GpuParams {
-        wave_count: s.noise.waves.len() as u32,
-        ..GpuParams::default()
-    };
     if let Some(t) = &prepared.color_table {
         lay.color_table = push_table(&mut data, t);
         base.ct_size_m = t.size_m as u32;

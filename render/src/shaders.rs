@@ -6,6 +6,9 @@ pub const SPECIAL: &str = include_str!("shaders/special.wgsl");
 /// The material model (mirrors of core's noise, transfer, tables, Smith, BRDF and footprint code).
 pub const MATERIAL: &str = include_str!("shaders/material.wgsl");
 
+/// The image driver (mirrors `lodestone_core::image_driver` and the image half of `driver_field`).
+pub const IMAGE_DRIVER: &str = include_str!("shaders/image_driver.wgsl");
+
 /// The curved object (mirrors `lodestone_core::cylinder`).
 pub const CYLINDER: &str = include_str!("shaders/cylinder.wgsl");
 
@@ -16,6 +19,7 @@ pub const VIEW: &str = include_str!("shaders/view.wgsl");
 pub const ALL: &[(&str, &str)] = &[
     ("special.wgsl", SPECIAL),
     ("material.wgsl", MATERIAL),
+    ("image_driver.wgsl", IMAGE_DRIVER),
     ("cylinder.wgsl", CYLINDER),
     ("view.wgsl", VIEW),
 ];
@@ -23,9 +27,11 @@ pub const ALL: &[(&str, &str)] = &[
 /// The sources a file needs before it (WGSL has no includes; files are concatenated in this order).
 pub fn prelude_for(name: &str) -> Vec<&'static str> {
     match name {
-        "material.wgsl" => vec![SPECIAL],
-        "cylinder.wgsl" => vec![SPECIAL, MATERIAL],
-        "view.wgsl" => vec![SPECIAL, MATERIAL, CYLINDER],
+        // material.wgsl and image_driver.wgsl call each other (module scope is order-free in WGSL).
+        "material.wgsl" => vec![SPECIAL, IMAGE_DRIVER],
+        "image_driver.wgsl" => vec![SPECIAL, MATERIAL],
+        "cylinder.wgsl" => vec![SPECIAL, MATERIAL, IMAGE_DRIVER],
+        "view.wgsl" => vec![SPECIAL, MATERIAL, IMAGE_DRIVER, CYLINDER],
         _ => vec![],
     }
 }

@@ -259,3 +259,34 @@ fn wgsl_snippet_equals_core_filtered() {
         configs.len()
     );
 }
+
+/// An image-driven material's bundle describes the pyramid: the level table in data.bin matches
+/// the image's levels.
+#[test]
+fn image_driver_bundle_describes_the_pyramid() {
+    let mut m = preset("default.ron");
+    m.driver = lodestone_core::material::Driver::Image {
+        path: "x.png".into(),
+        size: 2.0,
+    };
+    let values: Vec<f32> = (0..64 * 32).map(|i| ((i * 37) % 101) as f32).collect();
+    let img = std::sync::Arc::new(
+        lodestone_core::image_driver::ImageDriver::new(64, 32, &values).unwrap(),
+    );
+    let p = lodestone_core::footprint::Prepared::with_image(&m, Some(img.clone()), None).unwrap();
+    let files = bundle(&p).expect("bundle");
+    let manifest: serde_json::Value =
+        serde_json::from_slice(file(&files, "manifest.json")).unwrap();
+    let d = &manifest["tables"]["image_driver"];
+    assert_eq!(d["levels"], img.levels.len());
+    assert_eq!(d["size"][0], 64);
+    let data: &[f32] = bytemuck::cast_slice(file(&files, "data.bin"));
+    let table = d["level_table_offset_floats"].as_u64().unwrap() as usize;
+    for (l, level) in img.levels.iter().enumerate() {
+        let slot = &data[table + 5 * l..table + 5 * l + 5];
+        assert_eq!(slot[2].to_bits() as usize, level.width);
+        assert_eq!(slot[3].to_bits() as usize, level.height);
+        let v = slot[0].to_bits() as usize;
+        assert_eq!(data[v], level.value[0][0]);
+    }
+}

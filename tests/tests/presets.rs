@@ -2,8 +2,28 @@
 //! evaluates finite on the CPU and renders under every mode on the GPU adapter.
 
 use lodestone_core::footprint::{Config, Prepared};
-use lodestone_core::material::Material;
+use lodestone_core::image_driver::ImageDriver;
+use lodestone_core::material::{Driver, Material};
 use lodestone_core::smith::direction;
+use std::sync::Arc;
+
+/// Prepare a preset, decoding its driver image (relative to presets/) when it has one.
+fn prepare(path: &str, m: &Material) -> Prepared {
+    let image = match &m.driver {
+        Driver::Image { path: img, .. } => {
+            let file = std::path::Path::new(path).parent().unwrap().join(img);
+            let luma = image::open(&file)
+                .unwrap_or_else(|e| panic!("{path}: driver image {}: {e}", file.display()))
+                .to_luma32f();
+            let (w, h) = luma.dimensions();
+            Some(Arc::new(
+                ImageDriver::new(w as usize, h as usize, luma.as_raw()).unwrap(),
+            ))
+        }
+        Driver::Noise(_) => None,
+    };
+    Prepared::with_image(m, image, None).unwrap_or_else(|e| panic!("{path}: {e}"))
+}
 
 fn presets() -> Vec<(String, String)> {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../presets");
@@ -41,7 +61,7 @@ fn every_preset_loads_validates_and_round_trips() {
 fn every_preset_evaluates_finite() {
     for (path, text) in presets() {
         let m = Material::from_ron(&text).unwrap();
-        let p = Prepared::new(&m).unwrap_or_else(|e| panic!("{path}: {e}"));
+        let p = prepare(&path, &m);
         for deg in [0.0_f64, 60.0, 89.0] {
             let cfg = Config::far(&p, direction(deg.to_radians(), 0.2), direction(0.6, 2.0));
             for v in [
@@ -91,7 +111,7 @@ fn every_preset_renders() {
     };
     for (path, text) in presets() {
         let m = Material::from_ron(&text).unwrap();
-        let p = Prepared::new(&m).unwrap();
+        let p = prepare(&path, &m);
         let gm = GpuMaterial::new(r.context(), &p, scene.camera.target);
         for mode in [
             ViewMode::Naive,

@@ -19,6 +19,8 @@ pub struct Inspector {
     pub curve: CurveEditor,
     /// σ_nx and σ_ny move together.
     pub isotropic_lock: bool,
+    /// Skewness and excess kurtosis of the loaded image driver, if any (set by the editor).
+    pub driver_shape: Option<(f64, f64)>,
 }
 
 fn slider_f64(
@@ -79,6 +81,11 @@ impl Inspector {
         egui::CollapsingHeader::new("Slopes")
             .default_open(true)
             .show(ui, |ui| {
+                let from_image = matches!(m.driver, Driver::Image { .. });
+                if from_image {
+                    ui.label("An image driver's slopes come from the image (its gradients × σ_h); σ_n is not used.");
+                }
+                ui.add_enabled_ui(!from_image, |ui| {
                 let before = m.slopes;
                 changed |= slider_f64(
                     ui,
@@ -105,6 +112,7 @@ impl Inspector {
                         m.slopes.sigma_nx = m.slopes.sigma_ny;
                     }
                 }
+                });
             });
         egui::CollapsingHeader::new("Colour")
             .default_open(true)
@@ -214,6 +222,18 @@ impl Inspector {
                         changed = true;
                     }
                 });
+                if let Some((skew, kurt)) = self.driver_shape {
+                    ui.label(format!(
+                        "Histogram: skewness {skew:.2}, excess kurtosis {kurt:.2} (0 and 0 for a Gaussian)"
+                    ));
+                    if skew.abs() > 0.5 || kurt.abs() > 1.0 {
+                        ui.colored_label(
+                            ui.visuals().warn_fg_color,
+                            "Far from Gaussian: the filtered views approximate the driver by a Gaussian \
+                             [HNPN14 Sec. 4.2, Fig. 14]; expect larger errors, most at grazing angles.",
+                        );
+                    }
+                }
                 changed |= slider_f64(
                     ui,
                     size,

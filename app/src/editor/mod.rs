@@ -10,6 +10,7 @@ pub mod history;
 pub mod inspector;
 pub mod plots;
 pub mod priority;
+pub mod report_panel;
 pub mod view_state;
 mod views;
 pub mod worker;
@@ -21,7 +22,8 @@ use crate::preset_io;
 use egui::{Key, KeyboardShortcut, Modifiers};
 use history::History;
 use inspector::Inspector;
-use lodestone_core::material::Material;
+use lodestone_core::image_driver::ImageDriver;
+use lodestone_core::material::{Driver, Material};
 use lodestone_render::ViewMode;
 use lodestone_render::error_map::ErrorStats;
 use plots::AnglePlots;
@@ -118,6 +120,9 @@ pub struct EditorApp {
     material: Material,
     history: History,
     path: Option<PathBuf>,
+    /// The driver image: resolved path and what loading it gave (cached; reloaded when the path
+    /// or the preset's folder changes).
+    image: Option<(PathBuf, Result<Arc<ImageDriver>, String>)>,
     saved: Material,
     recent: Vec<PathBuf>,
     view: ViewState,
@@ -133,6 +138,7 @@ pub struct EditorApp {
     /// Size of one viewport's image in physical pixels (the largest, when they differ).
     view_px: [u32; 2],
     plots: AnglePlots,
+    report: report_panel::ReportPanel,
     notice: Option<Notice>,
     pending: Option<Pending>,
     frame_times: VecDeque<f64>,
@@ -204,6 +210,7 @@ impl EditorApp {
             inspector: Inspector::new(&material),
             material,
             path,
+            image: None,
             saved,
             recent: stored.recent.clone(),
             view: stored.view.clone(),
@@ -217,6 +224,7 @@ impl EditorApp {
             last_request: None,
             view_px: [0, 0],
             plots: AnglePlots::default(),
+            report: report_panel::ReportPanel::default(),
             notice,
             pending: None,
             frame_times: VecDeque::new(),
@@ -285,6 +293,39 @@ impl EditorApp {
         self.recent.retain(|q| q != p);
         self.recent.insert(0, p.to_owned());
         self.recent.truncate(MAX_RECENT);
+    }
+
+    /// The material with its driver image, loaded relative to the preset's folder (the current
+    /// directory for an unsaved material). A load failure is reported once per path and leaves the
+    /// image out (the views then show the material error).
+    fn resolved(&mut self, ctx: &egui::Context) -> preset_io::Resolved {
+        let image = match &self.material.driver {
+            Driver::Noise(_) => None,
+            Driver::Image { path, .. } => {
+                let dir = self
+                    .path
+                    .as_ref()
+                    .and_then(|p| p.parent())
+                    .unwrap_or(Path::new("."));
+                let full = dir.join(path);
+                if self.image.as_ref().is_none_or(|(p, _)| *p != full) {
+                    let r = preset_io::driver_image(&self.material, self.path.as_deref())
+                        .map_err(|e| e.to_string())
+                        .and_then(|i| i.ok_or_else(|| "no image".to_owned()));
+                    if let Err(e) = &r {
+                        self.notify(ctx, e.clone(), true);
+                    }
+                    self.image = Some((full, r));
+                }
+                self.image
+                    .as_ref()
+                    .and_then(|(_, r)| r.as_ref().ok().cloned())
+            }
+        };
+        preset_io::Resolved {
+            material: self.material.clone(),
+            image,
+        }
     }
 
     /// Open a preset now (no confirmation). Bad files leave everything as it was.
@@ -625,7 +666,7 @@ impl EditorApp {
     }
 
     /// Send the worker what the views need now, if it changed.
-    fn request_views(&mut self) {
+    fn request_views(&mut self, ctx: &egui::Context) {
         if self.view_px[0] == 0 || self.view_px[1] == 0 {
             return;
         }
@@ -644,9 +685,11 @@ impl EditorApp {
             return;
         }
         self.generation += 1;
+        let image = self.resolved(ctx).image;
         let req = Request {
             generation: self.generation,
             material: Arc::new(self.material.clone()),
+            image,
             scene,
             size: self.view_px,
             modes,
@@ -717,7 +760,8 @@ impl EditorApp {
                     .clicked()
                     && let Some(dir) = rfd::FileDialog::new().pick_folder()
                 {
-                    match preset_io::export_bundle(&self.material, &dir) {
+                    let preset = self.resolved(&ctx);
+                    match preset_io::export_bundle(&preset, &dir) {
                         Ok(w) => self.notify(
                             &ctx,
                             format!("Engine bundle: {} files in {}", w.len(), dir.display()),
@@ -779,6 +823,7 @@ impl EditorApp {
                     self.toggle_ab();
                 }
                 ui.checkbox(&mut self.view.show_plots, "Plots");
+                ui.checkbox(&mut self.report.open, "Error against run time report");
                 if ui.button("Sweep zoom (W)").clicked() {
                     self.toggle_sweep(&ctx);
                 }
@@ -798,6 +843,10 @@ impl EditorApp {
 
     fn status_bar(&mut self, ui: &mut egui::Ui) {
         ui.horizontal(|ui| {
+            if self.report.running() {
+                ui.weak("Report running");
+                ui.separator();
+            }
             match &self.device {
                 DeviceStatus::Starting => ui.weak("Starting the GPU device…"),
                 DeviceStatus::Ready(a) => ui.weak(format!("Adapter: {a}")),
@@ -995,6 +1044,10 @@ impl eframe::App for EditorApp {
             }
         }
 
+        if self.report.ui(&ctx) == report_panel::Action::Start {
+            let preset = self.resolved(&ctx);
+            self.report.start(preset, ctx.clone());
+        }
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
         egui::Panel::left("inspector")
@@ -1004,6 +1057,16 @@ impl eframe::App for EditorApp {
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| {
                     ui.heading("Material");
+                    if matches!(self.material.driver, Driver::Image { .. }) {
+                        // Loads the image when its path changed (cached otherwise).
+                        let _ = self.resolved(&ctx);
+                    }
+                    self.inspector.driver_shape = match (&self.material.driver, &self.image) {
+                        (Driver::Image { .. }, Some((_, Ok(img)))) => {
+                            Some((img.skewness, img.excess_kurtosis))
+                        }
+                        _ => None,
+                    };
                     if self.inspector.ui(ui, &mut self.material) {
                         ctx.request_repaint();
                     }
@@ -1020,8 +1083,9 @@ impl eframe::App for EditorApp {
             let interacting = ctx.egui_is_using_pointer();
             if !interacting && self.material.validate().is_ok() {
                 let c = ctx.clone();
+                let preset = self.resolved(&ctx);
                 self.plots
-                    .follow(&self.material, light, az, move || c.request_repaint());
+                    .follow(&preset, light, az, move || c.request_repaint());
             }
             egui::Panel::bottom("plots")
                 .resizable(true)
@@ -1033,7 +1097,7 @@ impl eframe::App for EditorApp {
 
         self.update_errors(&ctx);
         if self.material.validate().is_ok() {
-            self.request_views();
+            self.request_views(&ctx);
         }
         self.history
             .settle(&self.material, ctx.egui_is_using_pointer());

@@ -3,9 +3,10 @@
 //! truth. Computed by the CPU reference (lodestone-core) on a background thread, so a change of
 //! material never blocks the window; a newer request cancels an older one between angles.
 
+use crate::preset_io::Resolved;
 use egui::Color32;
 use egui_plot::{Corner, Legend, Line, Plot, PlotPoints};
-use lodestone_core::footprint::{Config, Prepared};
+use lodestone_core::footprint::Config;
 use lodestone_core::material::Material;
 use lodestone_core::smith::direction;
 use rayon::prelude::*;
@@ -44,12 +45,12 @@ pub fn luminance(c: [f64; 3]) -> f64 {
 
 /// The curves for one material and light, by the CPU reference. `cancel` returns true to stop.
 pub fn compute(
-    m: &Material,
+    m: &Resolved,
     light: glam::DVec3,
     azimuth_deg: f64,
     cancel: &(dyn Fn() -> bool + Sync),
 ) -> Result<Vec<AnglePoint>, String> {
-    let p = Prepared::new(m).map_err(|e| e.to_string())?;
+    let p = m.prepare().map_err(|e| e.to_string())?;
     let points: Vec<Option<AnglePoint>> = ANGLES
         .par_iter()
         .map(|&a| {
@@ -115,13 +116,13 @@ impl AnglePlots {
     /// changed. `repaint` wakes the UI when results arrive.
     pub fn follow(
         &mut self,
-        m: &Material,
+        m: &Resolved,
         light: glam::DVec3,
         azimuth_deg: f64,
         repaint: impl Fn() + Send + 'static,
     ) {
         let key = Key {
-            material: m.clone(),
+            material: m.material.clone(),
             light: light.to_array(),
             azimuth: azimuth_deg,
         };
@@ -271,7 +272,7 @@ mod tests {
     /// moderate angles, naive off at grazing angles (the default material).
     #[test]
     fn curves_show_filtered_tracking_truth() {
-        let m = crate::preset_io::default_material();
+        let m = Resolved::without_image(crate::preset_io::default_material());
         let light = direction(0.0, 0.0);
         let pts = compute(&m, light, 0.0, &|| false).expect("curves");
         assert_eq!(pts.len(), ANGLES.len());
@@ -288,7 +289,7 @@ mod tests {
 
     #[test]
     fn a_cancelled_computation_says_so() {
-        let m = crate::preset_io::default_material();
+        let m = Resolved::without_image(crate::preset_io::default_material());
         assert!(compute(&m, direction(0.0, 0.0), 0.0, &|| true).is_err());
     }
 }

@@ -351,3 +351,65 @@ fn every_character_of_the_editor_texts_has_a_glyph() {
         });
     h.run();
 }
+
+/// The report window: it opens from the View menu's state, runs on its own thread with progress,
+/// and a cancel stops it with a message (the report itself is tested through the command line).
+#[test]
+fn report_window_runs_and_cancels() {
+    let mut h = harness(1400.0, 800.0, DeviceSource::Unavailable);
+    h.state_mut().report.open = true;
+    h.run_steps(2);
+    h.get_by_label("Run").click();
+    h.run_steps(2);
+    assert!(h.state().report.running(), "the report starts");
+    h.get_by_label("Cancel").click();
+    let t0 = Instant::now();
+    while h.state().report.running() && t0.elapsed() < Duration::from_secs(240) {
+        h.step();
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    assert!(!h.state().report.running(), "cancelling stops the report");
+    h.get_by_label("Run");
+}
+
+/// Regenerates `screenshots/app/report-window.png`: the Error against run time window after a small
+/// report on the default preset (views off, so only the window is busy). Ignored by default:
+/// `cargo test --release -p lodestone -- --ignored regenerate_report_screenshot`.
+#[test]
+#[ignore = "regenerates screenshots/app/report-window.png (about a minute); run explicitly"]
+fn regenerate_report_screenshot() {
+    let mut h = harness(1600.0, 900.0, DeviceSource::Unavailable);
+    h.state_mut().report.open = true;
+    h.state_mut().report.set_budget(12, 8, 32);
+    h.run_steps(2);
+    h.get_by_label("Run").click();
+    h.run_steps(2);
+    let t0 = Instant::now();
+    while h.state().report.running() && t0.elapsed() < Duration::from_secs(900) {
+        h.step();
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    h.run_steps(3);
+    let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("../screenshots/app/report-window.png");
+    h.render().expect("render").save(out).expect("save");
+}
+
+/// An image driver's histogram shape is measured and shown in the inspector (cobblestones: skewness
+/// −0.27, excess kurtosis −0.78, the values `cargo run --example cobblestones` prints).
+#[test]
+fn image_driver_histogram_shape_is_shown() {
+    let mut h = harness(1400.0, 800.0, DeviceSource::Unavailable);
+    let ctx = h.ctx.clone();
+    h.state_mut().open_path(&ctx, &preset("cobblestones.ron"));
+    h.run_steps(3);
+    let (s, k) = h
+        .state()
+        .inspector
+        .driver_shape
+        .expect("the image is loaded");
+    assert!(
+        (s + 0.274).abs() < 0.01 && (k + 0.780).abs() < 0.01,
+        "{s} {k}"
+    );
+    h.get_by_label_contains("Histogram: skewness -0.27");
+}

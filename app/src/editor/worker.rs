@@ -13,6 +13,7 @@
 //! checking for a newer request between passes.
 
 use lodestone_core::footprint::Prepared;
+use lodestone_core::image_driver::ImageDriver;
 use lodestone_core::material::Material;
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
@@ -28,6 +29,8 @@ pub struct Request {
     pub generation: u64,
     /// The material.
     pub material: Arc<Material>,
+    /// Its driver image (image drivers only).
+    pub image: Option<Arc<ImageDriver>>,
     /// Camera and light.
     pub scene: Scene,
     /// Full size of one view in physical pixels.
@@ -216,13 +219,24 @@ impl State {
         }
     }
 
-    fn upload(&mut self, material: &Arc<Material>, send: &dyn Fn(Event)) -> bool {
+    fn upload(
+        &mut self,
+        material: &Arc<Material>,
+        image: &Option<Arc<ImageDriver>>,
+        send: &dyn Fn(Event),
+    ) -> bool {
+        let same_image = |p: &Prepared| match (p.surface.driver.image(), image) {
+            (None, None) => true,
+            (Some(a), Some(b)) => Arc::ptr_eq(&a.image, b),
+            _ => false,
+        };
         if let Some((m, _)) = &self.material
             && (Arc::ptr_eq(m, material) || **m == **material)
+            && self.prepared.as_ref().is_some_and(same_image)
         {
             return true;
         }
-        match Prepared::reusing(material, self.prepared.as_ref()) {
+        match Prepared::with_image(material, image.clone(), self.prepared.as_ref()) {
             Ok(p) => {
                 let gm = GpuMaterial::new(self.renderer.context(), &p, [0.0, 0.0]);
                 self.material = Some((material.clone(), gm));
@@ -278,7 +292,7 @@ impl State {
         rx: &Receiver<Request>,
         send: &dyn Fn(Event),
     ) -> Result<Option<Request>, ()> {
-        if !self.upload(&req.material, send) {
+        if !self.upload(&req.material, &req.image, send) {
             return Ok(None);
         }
         let max_scale = req.max_scale.clamp(MIN_SCALE, 1.0);
@@ -389,6 +403,7 @@ mod tests {
         Request {
             generation,
             material: Arc::new(Material::default()),
+            image: None,
             scene: Scene {
                 camera: Camera::default(),
                 light: direction(0.5, 1.0),

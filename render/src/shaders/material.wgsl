@@ -65,6 +65,14 @@ struct Params {
     dh_offset: u32,
     radius: f32,
     slope_bound: f32,
+    driver_kind: u32,
+    image_offset: u32,
+    image_levels: u32,
+    image_scale: f32,
+    image_u0: f32,
+    image_v0: f32,
+    image_lip_x: f32,
+    image_lip_y: f32,
 }
 
 @group(0) @binding(0) var<storage, read> params: Params;
@@ -156,8 +164,12 @@ fn wave(i: u32) -> vec4<f32> {
     return texel4(params.waves_offset, i);
 }
 
-// SumOfSines::value_and_gradient: (f, ∂f/∂x, ∂f/∂y).
+// DriverField::value_and_gradient: (f, ∂f/∂x, ∂f/∂y) of the noise (SumOfSines) or the image.
 fn value_and_gradient(x: vec2<f32>) -> vec3<f32> {
+    if (params.driver_kind == 1u) {
+        let v = image_value_and_gradient(image_texel(x));
+        return vec3<f32>(v.x, v.yz * params.image_scale);
+    }
     var v = 0.0;
     var g = vec2<f32>(0.0);
     for (var i = 0u; i < params.wave_count; i = i + 1u) {
@@ -169,8 +181,11 @@ fn value_and_gradient(x: vec2<f32>) -> vec3<f32> {
     return vec3<f32>(v, g);
 }
 
-// SumOfSines::filtered with footprint covariance (xx, yy, xy).
+// DriverField::filtered (SumOfSines::filtered for the noise) with footprint covariance (xx, yy, xy).
 fn filtered_driver(x: vec2<f32>, fp: vec3<f32>) -> FilteredDriver {
+    if (params.driver_kind == 1u) {
+        return image_filtered_driver(x, fp);
+    }
     var r: FilteredDriver;
     r.mean = 0.0;
     r.mean_gradient = vec2<f32>(0.0);
@@ -385,18 +400,40 @@ fn filtered_specular(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f3
         return 0.0;
     }
     let sh = slope_of(h);
-    let u_h = max(wo.z - sh.x * wo.x - sh.y * wo.y, 0.0);
-    let m = wo.z - mean.x * wo.x - mean.y * wo.y;
-    let v = wo.x * wo.x * cov.x + 2.0 * wo.x * wo.y * cov.z + wo.y * wo.y * cov.y;
-    var eu = max(m, 0.0);
+    let s0 = max(params.roughness, 0.0);
+    let total = cov + vec3<f32>(s0 * s0, s0 * s0, 0.0);
+    // Posterior of the facet slope given the half vector: s* = s̄ + K(s_h − s̄), Σ* = Σ − KΣ.
+    let det = total.x * total.y - total.z * total.z;
+    var post_mean = sh;
+    var post_cov = vec3<f32>(0.0);
+    if (det > 1e-30) {
+        let inv = vec3<f32>(total.y, total.x, -total.z) / det;
+        // K = Σ·C⁻¹ (general 2×2: columns k0, k1).
+        let k0 = vec2<f32>(cov.x * inv.x + cov.z * inv.z, cov.z * inv.x + cov.y * inv.z);
+        let k1 = vec2<f32>(cov.x * inv.z + cov.z * inv.y, cov.z * inv.z + cov.y * inv.y);
+        let d = sh - mean;
+        post_mean = mean + k0 * d.x + k1 * d.y;
+        // KΣ: columns K·(xx, xy) and K·(xy, yy).
+        let c0 = k0 * cov.x + k1 * cov.z;
+        let c1 = k0 * cov.z + k1 * cov.y;
+        post_cov = vec3<f32>(max(cov.x - c0.x, 0.0), max(cov.y - c1.y, 0.0), cov.z - 0.5 * (c0.y + c1.x));
+    }
+    let u_post = expected_positive_part(wo.z, wo.xy, post_mean, post_cov);
+    let eu = expected_positive_part(wo.z, wo.xy, mean, cov);
+    let dens = gaussian2(sh - mean, total);
+    return params.specular * dens * (u_post / max(eu, 1e-30)) / (4.0 * pow(h.z, 4.0) * wo.z);
+}
+
+// footprint::expected_positive_part: E[(a − s·b)⁺] for s ~ N(mean, cov).
+fn expected_positive_part(a: f32, b: vec2<f32>, mean: vec2<f32>, cov: vec3<f32>) -> f32 {
+    let m = a - dot(mean, b);
+    let v = b.x * b.x * cov.x + 2.0 * b.x * b.y * cov.z + b.y * b.y * cov.y;
     if (v > 1e-30) {
         let sv = sqrt(v);
         let r = clamp(m / sv, -40.0, 40.0);
-        eu = m * norm_cdf(r) + sv * norm_pdf(r);
+        return m * norm_cdf(r) + sv * norm_pdf(r);
     }
-    let s0 = max(params.roughness, 0.0);
-    let d = gaussian2(sh - mean, cov + vec3<f32>(s0 * s0, s0 * s0, 0.0));
-    return params.specular * d * (u_h / max(eu, 1e-30)) / (4.0 * pow(h.z, 4.0) * wo.z);
+    return max(m, 0.0);
 }
 
 // Prepared::point_input: (colour-map input, standardized height) at driver value f.
@@ -520,6 +557,9 @@ fn surface_height(x: vec2<f32>) -> f32 {
 }
 
 fn lipschitz_along(dir: vec2<f32>) -> f32 {
+    if (params.driver_kind == 1u) {
+        return params.sigma_h * params.g_lip * image_lipschitz_along(dir);
+    }
     var s = 0.0;
     for (var i = 0u; i < params.wave_count; i = i + 1u) {
         let w = wave(i);
@@ -547,6 +587,10 @@ fn march_heightfield(o: vec3<f32>, d: vec3<f32>, rate: f32, lod: bool, sf: f32) 
         return -1.0;
     }
     let top = params.h_max * (1.0 + 1e-6) + 1e-30;
+    // f32 guard (core marches in f64 and needs none): a step must move the point by more than the
+    // rounding of its coordinates, or a march leaving the surface never leaves it (its rounding-level
+    // negative gap then reads as a crossing: false shadows at extreme frequencies, σ_n ≫ σ_h).
+    let min_step = max(params.min_step, 4.8e-7 * (max(max(abs(o.x), abs(o.y)), abs(o.z)) + top));
     var t = 0.0;
     var prev_t = 0.0;
     var prev_r = 0.0;
@@ -561,7 +605,7 @@ fn march_heightfield(o: vec3<f32>, d: vec3<f32>, rate: f32, lod: bool, sf: f32) 
         let r = max(gap, 0.0) / rate;
         if (relaxed && t - prev_t > prev_r + r) {
             // The relaxed step left a stretch no safe interval covers: back off and step safely.
-            t = prev_t + max(prev_r, params.min_step);
+            t = prev_t + max(prev_r, min_step);
             relaxed = false;
             continue;
         }
@@ -584,8 +628,8 @@ fn march_heightfield(o: vec3<f32>, d: vec3<f32>, rate: f32, lod: bool, sf: f32) 
         }
         prev_t = t;
         prev_r = r;
-        let safe = max(r, params.min_step);
-        let step = max(RELAXATION * r, params.min_step);
+        let safe = max(r, min_step);
+        let step = max(RELAXATION * r, min_step);
         relaxed = step > safe;
         t = t + step;
     }
@@ -636,9 +680,18 @@ fn trace_ray(origin: vec3<f32>, dir: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
 // Per-invocation cache of each wave's footprint attenuation exp(−2π² kᵀΣk): constant along a pixel's
 // rays, so the march evaluates only cosines per step. Filled by lod_prepare (MAX_COMPONENTS = 256).
 var<private> lod_att: array<f32, 256>;
+// The image's probe plan for the pixel's footprint (set by lod_prepare).
+var<private> lod_plan: ProbePlan;
 
-// Fill lod_att for footprint fp; returns the phase-averaged footprint std σ_f.
+// Fill lod_att (or lod_plan) for footprint fp; returns the position-averaged footprint std σ_f
+// (DriverField::lod_moments).
 fn lod_prepare(fp: vec3<f32>) -> f32 {
+    if (params.driver_kind == 1u) {
+        let cov = fp * (params.image_scale * params.image_scale);
+        lod_plan = image_plan(cov);
+        let area = sqrt(sqrt(max(cov.x * cov.y - cov.z * cov.z, 0.0)));
+        return image_mean_std(lod_for_std(area));
+    }
     var v = 0.0;
     for (var i = 0u; i < params.wave_count; i = i + 1u) {
         let w = wave(i);
@@ -652,6 +705,9 @@ fn lod_prepare(fp: vec3<f32>) -> f32 {
 
 // f̄(x) with the cached attenuations.
 fn lod_mean(x: vec2<f32>) -> f32 {
+    if (params.driver_kind == 1u) {
+        return image_footprint_mean(image_texel(x), lod_plan);
+    }
     var m = 0.0;
     for (var i = 0u; i < params.wave_count; i = i + 1u) {
         let w = wave(i);
@@ -671,6 +727,9 @@ fn lod_rate(d: vec3<f32>) -> f32 {
     var k = 0.0;
     if (r > 0.0) {
         let dir = d.xy / r;
+        if (params.driver_kind == 1u) {
+            k = image_lipschitz_along(dir);
+        }
         for (var i = 0u; i < params.wave_count; i = i + 1u) {
             let w = wave(i);
             k = k + abs(w.z) * lod_att[i] * TAU * abs(dot(w.xy, dir));

@@ -1,0 +1,588 @@
+//! `lodestone report`: error against run time for one preset. Over view/light configurations and
+//! zoom levels it renders naive MIP, view-independent filtering, the filtered model with the paper's
+//! fits and uncorrelated masking, the filtered model with exact tables and correlated masking, and
+//! ground truth at 1…256 rays per pixel, each against a ground-truth reference (1024 rays per pixel by
+//! default), and reports RMSE (linear RGB), mean and 95th-percentile ΔE*ab and the time per frame.
+//!
+//! Honesty notes, also written into the report:
+//! * Ground truth at N rays is the first N rays of the reference's own low-discrepancy sequence, so
+//!   its RMSE against the reference is its noise with the reference's shared part removed,
+//!   `σ·√(1/N − 1/R)` for R reference rays (×0.87 at N = R/4).
+//! * The reference's own noise is `RMSE(first R/2 rays, all R)`, which estimates `σ/√R` exactly for
+//!   independent rays.
+//! * Times are synchronised wall times (submit, then wait for the device), medians of `repeats` runs;
+//!   timestamp queries are not used. On the software adapter they are CPU times.
+
+use crate::preset_io::Resolved;
+use anyhow::Result;
+use glam::DVec3;
+use lodestone_core::camera::Camera;
+use lodestone_core::cielab::delta_e76;
+use lodestone_core::cylinder::Shape;
+use lodestone_core::effective_height::HeightFilter;
+use lodestone_core::shadowing::Correlation;
+use lodestone_core::smith::direction;
+use lodestone_render::{
+    GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
+};
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+/// What to measure.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Image size of every rendering.
+    pub size: (u32, u32),
+    /// Rays per pixel of the reference.
+    pub reference_spp: u32,
+    /// View angles from the normal (degrees).
+    pub views: Vec<f64>,
+    /// Camera distances (zoom levels).
+    pub zooms: Vec<f64>,
+    /// Timing repeats (median).
+    pub repeats: u32,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Self {
+            size: (64, 40),
+            reference_spp: 1024,
+            views: vec![0.0, 30.0, 60.0, 75.0, 85.0, 89.0],
+            zooms: vec![1.5, 6.0, 40.0],
+            repeats: 5,
+        }
+    }
+}
+
+/// One method in one configuration.
+#[derive(Clone, Debug, Serialize)]
+pub struct MethodResult {
+    /// Method name.
+    pub method: String,
+    /// Rays per pixel (ground truth only).
+    pub spp: Option<u32>,
+    /// RMSE against the reference, linear RGB.
+    pub rmse: f64,
+    /// Mean ΔE*ab over the pixels that are not black in both.
+    pub delta_e_mean: f64,
+    /// 95th percentile of ΔE*ab.
+    pub delta_e_p95: f64,
+    /// Time per frame (ms), synchronised wall time, median.
+    pub ms: f64,
+}
+
+/// One view/light/zoom configuration.
+#[derive(Clone, Debug, Serialize)]
+pub struct ConfigResult {
+    /// Camera distance.
+    pub distance: f64,
+    /// View angle from the normal (degrees).
+    pub view_deg: f64,
+    /// Light: "normal", "view" or "opposite".
+    pub light: String,
+    /// RMSE of the reference's own noise (see the module docs).
+    pub reference_noise: f64,
+    /// Every method.
+    pub methods: Vec<MethodResult>,
+}
+
+/// The report.
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    /// Preset name.
+    pub preset: String,
+    /// The adapter.
+    pub adapter: String,
+    /// How times were taken.
+    pub timing: String,
+    /// Image size.
+    pub size: (u32, u32),
+    /// Reference rays per pixel.
+    pub reference_spp: u32,
+    /// The configurations.
+    pub configs: Vec<ConfigResult>,
+}
+
+/// Ground-truth sample counts compared against the reference.
+pub const TRUTH_SPP: [u32; 5] = [1, 4, 16, 64, 256];
+
+fn errors(img: &LinearImage, reference: &LinearImage) -> (f64, f64, f64) {
+    let (w, h) = (reference.width, reference.height);
+    let (mut sq, mut n) = (0.0, 0.0);
+    let mut de = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let a = img.rgb(x, y).map(f64::from);
+            let b = reference.rgb(x, y).map(f64::from);
+            for k in 0..3 {
+                sq += (a[k] - b[k]).powi(2);
+            }
+            n += 3.0;
+            if a != [0.0; 3] || b != [0.0; 3] {
+                de.push(delta_e76(a, b));
+            }
+        }
+    }
+    de.sort_by(f64::total_cmp);
+    let mean = if de.is_empty() {
+        0.0
+    } else {
+        de.iter().sum::<f64>() / de.len() as f64
+    };
+    let p95 = de
+        .get(((de.len() as f64 * 0.95) as usize).min(de.len().saturating_sub(1)))
+        .copied()
+        .unwrap_or(0.0);
+    ((sq / n).sqrt(), mean, p95)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    if v.is_empty() { 0.0 } else { v[v.len() / 2] }
+}
+
+fn timed(r: &Renderer, f: impl FnOnce()) -> f64 {
+    let t = Instant::now();
+    f();
+    r.wait();
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// Run the report with a progress bar on stderr.
+pub fn run(preset: &Resolved, opts: &Options) -> Result<Report> {
+    let r = run_with(
+        preset,
+        opts,
+        &|done, total, c| {
+            let width = 30;
+            let filled = done * width / total.max(1);
+            eprint!(
+                "\r[{}{}] {done}/{total}: distance {}, view {}°, light {}        ",
+                "#".repeat(filled),
+                "-".repeat(width - filled),
+                c.distance,
+                c.view_deg,
+                c.light
+            );
+        },
+        &|| false,
+    );
+    eprintln!();
+    r
+}
+
+/// Why a report stopped early.
+#[derive(Debug, thiserror::Error)]
+#[error("the report was cancelled")]
+pub struct Cancelled;
+
+/// Run the report; `progress(done, total, finished configuration)` after each configuration,
+/// `cancel()` checked between configurations (returns [`Cancelled`]).
+pub fn run_with(
+    preset: &Resolved,
+    opts: &Options,
+    progress: &dyn Fn(usize, usize, &ConfigResult),
+    cancel: &dyn Fn() -> bool,
+) -> Result<Report> {
+    let ctx = GpuContext::new_headless()?;
+    let adapter = ctx.describe();
+    let r = Renderer::new(ctx);
+    let mut exact = preset.material.clone();
+    exact.filtering.height_filter = HeightFilter::Exact;
+    exact.filtering.correlation = Correlation::HeightDirection;
+    let mut paper = preset.material.clone();
+    paper.filtering.height_filter = HeightFilter::PaperFit;
+    paper.filtering.correlation = Correlation::Uncorrelated;
+    let prepare = |m: &lodestone_core::material::Material| {
+        lodestone_core::footprint::Prepared::with_image(m, preset.image.clone(), None)
+    };
+    let (p_exact, p_paper) = (prepare(&exact)?, prepare(&paper)?);
+    let target = [0.3, 0.7];
+    let gm_exact = GpuMaterial::new(r.context(), &p_exact, target);
+    let gm_paper = GpuMaterial::new(r.context(), &p_paper, target);
+    let total = opts.zooms.len() * opts.views.len() * 3;
+    let mut configs = Vec::new();
+    let mut done = 0;
+    let ref_spp = opts.reference_spp.max(2);
+    for &distance in &opts.zooms {
+        for &view in &opts.views {
+            for light_name in ["normal", "view", "opposite"] {
+                if cancel() {
+                    return Err(Cancelled.into());
+                }
+                done += 1;
+                let light = match light_name {
+                    "normal" => DVec3::Z,
+                    "view" => direction(view.to_radians(), 0.0),
+                    _ => direction(view.to_radians(), std::f64::consts::PI),
+                };
+                let scene = Scene {
+                    camera: Camera {
+                        elevation_deg: view,
+                        azimuth_deg: 0.0,
+                        distance,
+                        target,
+                        fov_deg: 30.0,
+                    },
+                    light,
+                    shape: Shape::Plane,
+                };
+                // Ground truth: one progressive accumulation gives every N and the reference.
+                let mut milestones: Vec<u32> =
+                    TRUTH_SPP.iter().copied().filter(|n| *n < ref_spp).collect();
+                milestones.push(ref_spp / 2);
+                milestones.push(ref_spp);
+                milestones.sort_unstable();
+                milestones.dedup();
+                let mut tgt = ViewTarget::new(&r, opts.size.0, opts.size.1);
+                let mut truth = Vec::new();
+                let mut frame_ms = Vec::new();
+                let mut have = 0;
+                for n in milestones {
+                    let add = n - have;
+                    let ms = timed(&r, || {
+                        r.draw(&mut tgt, &gm_exact, &scene, ViewMode::Truth, add)
+                    });
+                    frame_ms.push(ms / f64::from(add));
+                    have = n;
+                    truth.push((n, tgt.read(&r)?));
+                }
+                let reference = &truth.last().expect("reference").1;
+                let half = &truth
+                    .iter()
+                    .find(|(n, _)| *n == ref_spp / 2)
+                    .expect("half")
+                    .1;
+                let reference_noise = errors(half, reference).0;
+                let ray_ms = median(frame_ms);
+                let mut methods = Vec::new();
+                for (name, mode, gm) in [
+                    ("naive MIP", ViewMode::Naive, &gm_exact),
+                    ("view-independent", ViewMode::ViewIndependent, &gm_exact),
+                    (
+                        "filtered (paper fits, uncorrelated)",
+                        ViewMode::Filtered,
+                        &gm_paper,
+                    ),
+                    (
+                        "filtered (exact, correlated)",
+                        ViewMode::Filtered,
+                        &gm_exact,
+                    ),
+                ] {
+                    let mut img = None;
+                    let mut times = Vec::new();
+                    for _ in 0..opts.repeats.max(1) {
+                        let mut t = ViewTarget::new(&r, opts.size.0, opts.size.1);
+                        times.push(timed(&r, || r.draw(&mut t, gm, &scene, mode, 1)));
+                        img = Some(t.read(&r)?);
+                    }
+                    let (rmse, de, p95) = errors(img.as_ref().expect("rendered"), reference);
+                    methods.push(MethodResult {
+                        method: name.into(),
+                        spp: None,
+                        rmse,
+                        delta_e_mean: de,
+                        delta_e_p95: p95,
+                        ms: median(times),
+                    });
+                }
+                for (n, img) in &truth {
+                    if !TRUTH_SPP.contains(n) || *n >= ref_spp {
+                        continue;
+                    }
+                    let (rmse, de, p95) = errors(img, reference);
+                    methods.push(MethodResult {
+                        method: format!("ground truth {n} spp"),
+                        spp: Some(*n),
+                        rmse,
+                        delta_e_mean: de,
+                        delta_e_p95: p95,
+                        ms: ray_ms * f64::from(*n),
+                    });
+                }
+                let c = ConfigResult {
+                    distance,
+                    view_deg: view,
+                    light: light_name.into(),
+                    reference_noise,
+                    methods,
+                };
+                progress(done, total, &c);
+                configs.push(c);
+            }
+        }
+    }
+    Ok(Report {
+        preset: preset.material.name.clone(),
+        adapter,
+        timing: format!(
+            "synchronised wall time (submit + wait), median of {} runs; no timestamp queries",
+            opts.repeats.max(1)
+        ),
+        size: opts.size,
+        reference_spp: ref_spp,
+        configs,
+    })
+}
+
+/// The Markdown tables: per zoom, RMSE and mean ΔE of every method per configuration, then the
+/// averages with the time per frame.
+pub fn markdown(rep: &Report) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "# Report: {}\n\nAdapter: {}. {}×{} pixels, reference {} rays per pixel. Times: {}.\n\n\
+         Ground truth at N rays is a prefix of the reference's ray sequence (its RMSE is σ√(1/N − 1/R)); \
+         the reference's own noise is the RMSE between its first half and all of it (column `ref. noise`).\n",
+        rep.preset, rep.adapter, rep.size.0, rep.size.1, rep.reference_spp, rep.timing
+    );
+    let names: Vec<String> = rep
+        .configs
+        .first()
+        .map(|c| c.methods.iter().map(|m| m.method.clone()).collect())
+        .unwrap_or_default();
+    let mut zooms: Vec<f64> = rep.configs.iter().map(|c| c.distance).collect();
+    zooms.dedup();
+    for z in zooms {
+        let cs: Vec<&ConfigResult> = rep.configs.iter().filter(|c| c.distance == z).collect();
+        let _ = writeln!(s, "## Distance {z}: RMSE (linear RGB) / mean ΔE*ab\n");
+        let _ = writeln!(s, "| view | light | ref. noise | {} |", names.join(" | "));
+        let _ = writeln!(s, "|---|---|---|{}", "---|".repeat(names.len()));
+        for c in &cs {
+            let cells: Vec<String> = c
+                .methods
+                .iter()
+                .map(|m| format!("{:.4} / {:.2}", m.rmse, m.delta_e_mean))
+                .collect();
+            let _ = writeln!(
+                s,
+                "| {}° | {} | {:.4} | {} |",
+                c.view_deg,
+                c.light,
+                c.reference_noise,
+                cells.join(" | ")
+            );
+        }
+        let _ = writeln!(s, "\nAverages over the configurations above:\n");
+        let _ = writeln!(s, "| method | RMSE | mean ΔE | p95 ΔE | ms/frame |");
+        let _ = writeln!(s, "|---|---|---|---|---|");
+        for (i, name) in names.iter().enumerate() {
+            let avg = |f: &dyn Fn(&MethodResult) -> f64| {
+                cs.iter().map(|c| f(&c.methods[i])).sum::<f64>() / cs.len().max(1) as f64
+            };
+            let _ = writeln!(
+                s,
+                "| {name} | {:.4} | {:.2} | {:.2} | {:.1} |",
+                avg(&|m| m.rmse),
+                avg(&|m| m.delta_e_mean),
+                avg(&|m| m.delta_e_p95),
+                avg(&|m| m.ms)
+            );
+        }
+        let _ = writeln!(s);
+    }
+    s
+}
+
+/// One chart series: label, colour, points, joined by a line.
+type Series<'a> = (String, &'a str, Vec<(f64, f64)>, bool);
+
+const COLORS: [&str; 5] = ["#d62728", "#1f77b4", "#ff7f0e", "#2ca02c", "#555555"];
+
+/// A minimal SVG line/point chart: `series` of (label, colour, points); log axes when asked.
+fn svg_chart(
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    log_x: bool,
+    log_y: bool,
+) -> String {
+    let (w, h, ml, mr, mt, mb) = (720.0, 440.0, 70.0, 230.0, 40.0, 50.0);
+    let tx = |v: f64| if log_x { v.max(1e-12).log10() } else { v };
+    let ty = |v: f64| if log_y { v.max(1e-12).log10() } else { v };
+    let pts: Vec<(f64, f64)> = series
+        .iter()
+        .flat_map(|s| s.2.iter().map(|p| (tx(p.0), ty(p.1))))
+        .collect();
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for (x, y) in &pts {
+        x0 = x0.min(*x);
+        x1 = x1.max(*x);
+        y0 = y0.min(*y);
+        y1 = y1.max(*y);
+    }
+    if !(x1 > x0) {
+        x1 = x0 + 1.0;
+    }
+    if !(y1 > y0) {
+        y1 = y0 + 1.0;
+    }
+    let px = |x: f64| ml + (tx(x) - x0) / (x1 - x0) * (w - ml - mr);
+    let py = |y: f64| h - mb - (ty(y) - y0) / (y1 - y0) * (h - mt - mb);
+    let mut s = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n\
+         <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"{ml}\" y=\"22\" font-size=\"15\">{title}</text>\n\
+         <line x1=\"{ml}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"black\"/>\n<line x1=\"{ml}\" y1=\"{mt}\" x2=\"{ml}\" y2=\"{}\" stroke=\"black\"/>\n",
+        h - mb,
+        w - mr,
+        h - mb,
+        h - mb
+    );
+    let fmt = |v: f64, log: bool| {
+        let x = if log { 10f64.powf(v) } else { v };
+        if x != 0.0 && (x.abs() < 0.01 || x.abs() >= 1e4) {
+            format!("{x:.2e}")
+        } else {
+            format!("{x:.3}")
+        }
+    };
+    for i in 0..=4 {
+        let fx = x0 + (x1 - x0) * f64::from(i) / 4.0;
+        let fy = y0 + (y1 - y0) * f64::from(i) / 4.0;
+        let gx = ml + (w - ml - mr) * f64::from(i) / 4.0;
+        let gy = h - mb - (h - mt - mb) * f64::from(i) / 4.0;
+        let _ = writeln!(
+            s,
+            "<text x=\"{gx}\" y=\"{}\" text-anchor=\"middle\">{}</text>",
+            h - mb + 16.0,
+            fmt(fx, log_x)
+        );
+        let _ = writeln!(
+            s,
+            "<text x=\"{}\" y=\"{}\" text-anchor=\"end\">{}</text>",
+            ml - 6.0,
+            gy + 4.0,
+            fmt(fy, log_y)
+        );
+        let _ = writeln!(
+            s,
+            "<line x1=\"{ml}\" y1=\"{gy}\" x2=\"{}\" y2=\"{gy}\" stroke=\"#ddd\"/>",
+            w - mr
+        );
+    }
+    let _ = writeln!(
+        s,
+        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{x_label}</text>",
+        (ml + w - mr) / 2.0,
+        h - 12.0
+    );
+    let _ = writeln!(
+        s,
+        "<text x=\"16\" y=\"{}\" transform=\"rotate(-90 16 {})\" text-anchor=\"middle\">{y_label}</text>",
+        (mt + h - mb) / 2.0,
+        (mt + h - mb) / 2.0
+    );
+    for (i, (label, color, points, line)) in series.iter().enumerate() {
+        if *line && points.len() > 1 {
+            let path: Vec<String> = points
+                .iter()
+                .map(|(x, y)| format!("{:.1},{:.1}", px(*x), py(*y)))
+                .collect();
+            let _ = writeln!(
+                s,
+                "<polyline fill=\"none\" stroke=\"{color}\" stroke-width=\"2\" points=\"{}\"/>",
+                path.join(" ")
+            );
+        }
+        for (x, y) in points {
+            let _ = writeln!(
+                s,
+                "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"4\" fill=\"{color}\"/>",
+                px(*x),
+                py(*y)
+            );
+        }
+        let ly = mt + 18.0 * i as f64;
+        let _ = writeln!(
+            s,
+            "<circle cx=\"{}\" cy=\"{ly}\" r=\"5\" fill=\"{color}\"/><text x=\"{}\" y=\"{}\">{label}</text>",
+            w - mr + 16.0,
+            w - mr + 26.0,
+            ly + 4.0
+        );
+    }
+    s + "</svg>\n"
+}
+
+/// Error (mean ΔE*ab: robust, unlike RMSE, to the few firefly pixels near the horizon) against time
+/// (log–log; one point per method averaged over the configurations, a curve for ground truth over
+/// rays per pixel) and against view angle per method (light at the normal, middle zoom), as SVG.
+pub fn charts(rep: &Report) -> (String, String) {
+    let names: Vec<String> = rep
+        .configs
+        .first()
+        .map(|c| c.methods.iter().map(|m| m.method.clone()).collect())
+        .unwrap_or_default();
+    let n = rep.configs.len().max(1) as f64;
+    let avg = |i: usize, f: &dyn Fn(&MethodResult) -> f64| {
+        rep.configs.iter().map(|c| f(&c.methods[i])).sum::<f64>() / n
+    };
+    let mut series = Vec::new();
+    let mut truth_curve = Vec::new();
+    for (i, name) in names.iter().enumerate() {
+        let p = (avg(i, &|m| m.ms), avg(i, &|m| m.delta_e_mean));
+        if name.starts_with("ground truth") {
+            truth_curve.push(p);
+        } else {
+            series.push((name.clone(), COLORS[series.len() % 4], vec![p], false));
+        }
+    }
+    series.push((
+        "ground truth, 1…256 spp".into(),
+        COLORS[4],
+        truth_curve,
+        true,
+    ));
+    let time_chart = svg_chart(
+        &format!("{}: error against time", rep.preset),
+        "ms per frame (log)",
+        "mean ΔE*ab vs reference (log)",
+        &series,
+        true,
+        true,
+    );
+    let mut zooms: Vec<f64> = rep.configs.iter().map(|c| c.distance).collect();
+    zooms.dedup();
+    let mid = zooms.get(zooms.len() / 2).copied().unwrap_or(0.0);
+    let mut series = Vec::new();
+    for (i, name) in names.iter().enumerate() {
+        if name.starts_with("ground truth") && name != "ground truth 16 spp" {
+            continue;
+        }
+        let pts: Vec<(f64, f64)> = rep
+            .configs
+            .iter()
+            .filter(|c| c.distance == mid && c.light == "normal")
+            .map(|c| (c.view_deg, c.methods[i].delta_e_mean))
+            .collect();
+        series.push((name.clone(), COLORS[series.len() % 5], pts, true));
+    }
+    let view_chart = svg_chart(
+        &format!(
+            "{}: error against view angle (distance {mid}, light at the normal)",
+            rep.preset
+        ),
+        "view angle from the normal (degrees)",
+        "mean ΔE*ab vs reference (log)",
+        &series,
+        false,
+        true,
+    );
+    (time_chart, view_chart)
+}
+
+/// Write report.json, report.md, error_vs_time.svg and error_vs_view.svg into `dir`.
+pub fn write(rep: &Report, dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir)?;
+    std::fs::write(dir.join("report.json"), serde_json::to_string_pretty(rep)?)?;
+    std::fs::write(dir.join("report.md"), markdown(rep))?;
+    let (t, v) = charts(rep);
+    std::fs::write(dir.join("error_vs_time.svg"), t)?;
+    std::fs::write(dir.join("error_vs_view.svg"), v)?;
+    Ok(())
+}

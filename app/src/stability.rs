@@ -1,0 +1,216 @@
+//! `lodestone stability`: core's stiff and extreme cases (f64 and the f32 mirror, see
+//! `lodestone_core::stability`) plus the same cases through the WGSL on the GPU adapter.
+//!
+//! WGSL rows: the special functions on the same arguments (bound 1e-5·(1 + x²) relative: WGSL lets
+//! `exp`/`log` be off by a few ULP more than Rust's), and every material case rendered far away
+//! (8×8 pixels, camera at the listed angles from the normal plus 60°, every mode, the ground truth
+//! with 1 ray where core traces it too, [`stability::truth_traceable`]): non-finite or negative pixels
+//! are failures; the deviation is the fraction of pixels
+//! below 89.9° whose analytic value differs from core's evaluation of that pixel by more than
+//! 0.5% + 2e-4 (bound 2%: f32 against f64 rays may cross a shadow edge differently).
+//! `LODESTONE_STABILITY_DEBUG=1` prints every failing WGSL pixel.
+
+use anyhow::Result;
+use glam::DVec2;
+use lodestone_core::camera::Camera;
+use lodestone_core::cylinder::Shape;
+use lodestone_core::footprint::{Method, Prepared};
+use lodestone_core::noise::Footprint;
+use lodestone_core::smith::direction;
+use lodestone_core::stability::{
+    self, Path, Row, SPECIAL_FUNCTIONS, deviation, material_cases, special_inputs,
+    special_reference,
+};
+use lodestone_render::{GpuContext, GpuMaterial, Renderer, Scene, ViewMode, compute, shaders};
+
+fn wgsl_special_rows(ctx: &GpuContext) -> Vec<Row> {
+    SPECIAL_FUNCTIONS
+        .iter()
+        .map(|name| {
+            let xs = special_inputs(name);
+            let xf: Vec<f32> = xs.iter().map(|x| *x as f32).collect();
+            let got = compute::eval_unary(ctx, shaders::SPECIAL, name, &xf);
+            let (mut dev, mut bad) = (0.0f64, 0);
+            for ((x, g), xs32) in xs.iter().zip(&got).zip(&xf) {
+                let g = f64::from(*g);
+                if !g.is_finite() {
+                    bad += 1;
+                }
+                let r =
+                    special_reference(name, *x).clamp(-f64::from(f32::MAX), f64::from(f32::MAX));
+                let x2 = f64::from(*xs32).powi(2).min(1e6);
+                dev = dev.max(deviation(g, r, 1e-30) / (1.0 + x2));
+            }
+            Row {
+                case: format!("{name} at {} extreme arguments", xs.len()),
+                path: Path::Wgsl,
+                outputs: xs.len(),
+                max_deviation: dev,
+                bound: 1e-5,
+                non_finite: bad,
+                reference: "quadrature (relative / (1 + x²))".into(),
+            }
+        })
+        .collect()
+}
+
+fn wgsl_material_rows(r: &Renderer) -> Vec<Row> {
+    let (w, h) = (8u32, 8u32);
+    let mut degs: Vec<f64> = stability::angles().iter().map(|a| a.to_degrees()).collect();
+    degs.push(60.0);
+    let light = direction(0.7, 2.0);
+    material_cases()
+        .into_iter()
+        .map(|case| {
+            let p = match Prepared::with_image(&case.material, case.image.clone(), None) {
+                Ok(p) => p,
+                Err(e) => {
+                    return Row {
+                        case: format!("{}: {e}", case.name),
+                        path: Path::Wgsl,
+                        outputs: 0,
+                        max_deviation: f64::INFINITY,
+                        bound: 0.0,
+                        non_finite: 1,
+                        reference: String::new(),
+                    };
+                }
+            };
+            let (mut outputs, mut bad, mut compared, mut off) = (0, 0, 0, 0);
+            for deg in &degs {
+                let camera = Camera {
+                    elevation_deg: *deg,
+                    azimuth_deg: 30.0,
+                    distance: 50.0,
+                    target: [3.0, -2.0],
+                    fov_deg: 20.0,
+                };
+                let scene = Scene {
+                    camera,
+                    light,
+                    shape: Shape::Plane,
+                };
+                let gm = GpuMaterial::new(r.context(), &p, camera.target);
+                for mode in [
+                    ViewMode::Naive,
+                    ViewMode::ViewIndependent,
+                    ViewMode::Filtered,
+                    ViewMode::Truth,
+                ] {
+                    if mode == ViewMode::Truth && !stability::truth_traceable(&p) {
+                        continue;
+                    }
+                    let Ok(img) = r.render(&gm, &scene, mode, (w, h), 1) else {
+                        bad += (w * h) as usize;
+                        continue;
+                    };
+                    for y in 0..h {
+                        for x in 0..w {
+                            let got = img.rgb(x, y);
+                            outputs += 3;
+                            let nb = got.iter().filter(|v| !v.is_finite() || **v < 0.0).count();
+                            if nb > 0 && std::env::var("LODESTONE_STABILITY_DEBUG").is_ok() {
+                                eprintln!("{} {mode:?} {deg}° ({x},{y}): {got:?}", case.name);
+                            }
+                            bad += nb;
+                            let method = match mode {
+                                ViewMode::Naive => Method::Naive,
+                                ViewMode::ViewIndependent => Method::ViewIndependent,
+                                ViewMode::Filtered => Method::Filtered,
+                                ViewMode::Truth => continue,
+                            };
+                            if *deg >= 89.9 {
+                                continue;
+                            }
+                            let c = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                            let Some((_, cov)) = camera.plane_footprint(c, w, h) else {
+                                continue;
+                            };
+                            let ray = camera.ray(c, w, h);
+                            let want =
+                                p.pixel(method, ray.origin, ray.dir, light, Footprint { cov });
+                            compared += 1;
+                            if (0..3).any(|k| {
+                                (f64::from(got[k]) - want[k]).abs() > 5e-3 * want[k].abs() + 2e-4
+                            }) {
+                                if std::env::var("LODESTONE_STABILITY_DEBUG").is_ok() && off < 3 {
+                                    eprintln!(
+                                        "{} {mode:?} {deg}° ({x},{y}): GPU {got:?} core {want:?}",
+                                        case.name
+                                    );
+                                }
+                                off += 1;
+                            }
+                        }
+                    }
+                }
+            }
+            Row {
+                case: case.name,
+                path: Path::Wgsl,
+                outputs,
+                max_deviation: if compared > 0 {
+                    off as f64 / compared as f64
+                } else {
+                    0.0
+                },
+                bound: 0.02,
+                non_finite: bad,
+                reference: "core's pixel (fraction of pixels off by > 0.5%)".into(),
+            }
+        })
+        .collect()
+}
+
+/// Every row: CPU, then WGSL when an adapter is found (otherwise a note on stderr).
+pub fn rows() -> Vec<Row> {
+    let mut rows = stability::cpu_rows();
+    match GpuContext::new_headless() {
+        Ok(ctx) => {
+            rows.extend(wgsl_special_rows(&ctx));
+            rows.extend(wgsl_material_rows(&Renderer::new(ctx)));
+        }
+        Err(e) => eprintln!("no GPU adapter, WGSL rows skipped: {e}"),
+    }
+    rows
+}
+
+/// The table.
+pub fn table(rows: &[Row]) -> String {
+    let mut s = format!(
+        "{:<62} {:<9} {:>7} {:>12} {:>9} {:>10}  {}\n",
+        "case", "path", "outputs", "max dev.", "bound", "non-finite", "result"
+    );
+    for r in rows {
+        s += &format!(
+            "{:<62} {:<9} {:>7} {:>12.3e} {:>9.1e} {:>10}  {}\n",
+            r.case,
+            r.path.name(),
+            r.outputs,
+            r.max_deviation,
+            r.bound,
+            r.non_finite,
+            if r.passed() { "ok" } else { "FAIL" }
+        );
+    }
+    s
+}
+
+/// `lodestone stability [--json]`: prints the table (or JSON) and fails when a row fails.
+pub fn run(json: bool) -> Result<()> {
+    let rows = rows();
+    if json {
+        println!("{}", serde_json::to_string_pretty(&rows)?);
+    } else {
+        print!("{}", table(&rows));
+        println!("reference and unit of each deviation:");
+        for r in &rows {
+            println!("  {} [{}]: {}", r.case, r.path.name(), r.reference);
+        }
+    }
+    let failed = rows.iter().filter(|r| !r.passed()).count();
+    if failed > 0 {
+        anyhow::bail!("{failed} of {} stability rows failed", rows.len());
+    }
+    Ok(())
+}
