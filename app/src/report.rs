@@ -180,7 +180,7 @@ pub fn run(preset: &Resolved, opts: &Options) -> Result<Report> {
 pub struct Cancelled;
 
 /// Run the report; `progress(done, total, finished configuration)` after each configuration,
-/// `cancel()` checked between configurations (returns [`Cancelled`]).
+/// `cancel()` checked between configurations and between truth passes (returns [`Cancelled`]).
 pub fn run_with(
     preset: &Resolved,
     opts: &Options,
@@ -242,6 +242,9 @@ pub fn run_with(
                 let mut frame_ms = Vec::new();
                 let mut have = 0;
                 for n in milestones {
+                    if cancel() {
+                        return Err(Cancelled.into());
+                    }
                     let add = n - have;
                     let ms = timed(&r, || {
                         r.draw(&mut tgt, &gm_exact, &scene, ViewMode::Truth, add)

@@ -94,6 +94,20 @@ pub struct AnglePlots {
     points: Vec<AnglePoint>,
     error: Option<String>,
     busy: Arc<Mutex<bool>>,
+    /// Computation threads not yet joined (superseded ones finish at their next cancel check).
+    threads: Vec<std::thread::JoinHandle<()>>,
+}
+
+impl Drop for AnglePlots {
+    /// Cancels and joins every computation, so no thread outlives the editor.
+    fn drop(&mut self) {
+        self.generation.fetch_add(1, Ordering::SeqCst);
+        for t in self.threads.drain(..) {
+            if t.join().is_err() {
+                log::error!("a plot computation panicked");
+            }
+        }
+    }
 }
 
 impl Default for AnglePlots {
@@ -107,6 +121,7 @@ impl Default for AnglePlots {
             points: Vec::new(),
             error: None,
             busy: Arc::new(Mutex::new(false)),
+            threads: Vec::new(),
         }
     }
 }
@@ -138,7 +153,8 @@ impl AnglePlots {
         if let Ok(mut b) = busy.lock() {
             *b = true;
         }
-        std::thread::spawn(move || {
+        self.threads.retain(|t| !t.is_finished());
+        self.threads.push(std::thread::spawn(move || {
             super::priority::lower_current_thread();
             let cancel = || counter.load(Ordering::SeqCst) != generation;
             let r = compute(&m, light, azimuth_deg, &cancel);
@@ -149,7 +165,7 @@ impl AnglePlots {
                 let _ = tx.send((generation, r));
                 repaint();
             }
-        });
+        }));
     }
 
     /// Take finished results.

@@ -36,6 +36,16 @@ pub struct ReportPanel {
     cancel: Arc<AtomicBool>,
     running: bool,
     message: Option<String>,
+    /// The running (or last) report thread, joined before the next starts and on drop.
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Drop for ReportPanel {
+    /// Cancels a running report and waits for its thread, so its GPU device is gone before the
+    /// process exits (see `Worker`'s drop).
+    fn drop(&mut self) {
+        self.stop();
+    }
 }
 
 impl Default for ReportPanel {
@@ -49,6 +59,7 @@ impl Default for ReportPanel {
             cancel: Arc::new(AtomicBool::new(false)),
             running: false,
             message: None,
+            thread: None,
         }
     }
 }
@@ -81,9 +92,19 @@ impl ReportPanel {
         self.running
     }
 
+    /// Cancel a running report and wait for its thread (at most one truth pass).
+    fn stop(&mut self) {
+        self.cancel.store(true, Ordering::SeqCst);
+        if let Some(t) = self.thread.take()
+            && t.join().is_err()
+        {
+            log::error!("the report thread panicked");
+        }
+    }
+
     /// Start a report on `preset` (cancels a running one).
     pub fn start(&mut self, preset: Resolved, ctx: egui::Context) {
-        self.cancel.store(true, Ordering::SeqCst);
+        self.stop();
         self.cancel = Arc::new(AtomicBool::new(false));
         self.shared = Arc::default();
         self.running = true;
@@ -95,7 +116,7 @@ impl ReportPanel {
             ..Options::default()
         };
         let (shared, cancel) = (self.shared.clone(), self.cancel.clone());
-        std::thread::spawn(move || {
+        self.thread = Some(std::thread::spawn(move || {
             super::priority::lower_current_thread();
             let progress = |done: usize, total: usize, c: &ConfigResult| {
                 if let Ok(mut s) = shared.lock() {
@@ -110,7 +131,7 @@ impl ReportPanel {
                 s.finished = Some(r.map_err(|e| format!("{e:#}")));
             }
             ctx.request_repaint();
-        });
+        }));
     }
 
     /// The window; returns what the editor should do.

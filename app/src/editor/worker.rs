@@ -83,8 +83,24 @@ pub enum Event {
 /// Handle on the worker thread.
 #[derive(Debug)]
 pub struct Worker {
-    requests: Sender<Request>,
+    /// `None` only while dropping: taking it disconnects the channel, which stops the thread.
+    requests: Option<Sender<Request>>,
     events: Receiver<Event>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Drop for Worker {
+    /// Stops the thread and waits for it, so the GPU device is torn down before the process
+    /// exits: a detached thread still dropping an llvmpipe device while the process runs its
+    /// exit handlers corrupted the heap (`malloc_consolidate(): unaligned fastbin chunk`).
+    fn drop(&mut self) {
+        self.requests.take();
+        if let Some(t) = self.thread.take()
+            && t.join().is_err()
+        {
+            log::error!("the render thread panicked");
+        }
+    }
 }
 
 /// Where the worker's device comes from.
@@ -136,18 +152,21 @@ impl Worker {
                     Err(e) => send(Event::NoAdapter(e)),
                 }
             });
-        if let Err(e) = spawned {
-            log::error!("cannot start the render thread: {e}");
-        }
+        let thread = spawned
+            .inspect_err(|e| log::error!("cannot start the render thread: {e}"))
+            .ok();
         Self {
-            requests: req_tx,
+            requests: Some(req_tx),
             events: ev_rx,
+            thread,
         }
     }
 
     /// Ask for a new set of views (replaces any pending request).
     pub fn request(&self, r: Request) {
-        let _ = self.requests.send(r);
+        if let Some(tx) = &self.requests {
+            let _ = tx.send(r);
+        }
     }
 
     /// Events that arrived since the last call.
