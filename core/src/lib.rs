@@ -16,6 +16,7 @@ pub mod colormap;
 pub mod cylinder;
 pub mod driver_field;
 pub mod effective_height;
+pub mod features;
 pub mod footprint;
 pub mod image_driver;
 pub mod material;

@@ -20,6 +20,7 @@ use crate::gpu_types::{GpuParams, gpu_params_offsets};
 use crate::renderer::material_data;
 use crate::shaders;
 use lodestone_core::effective_height::EffectiveHeightTable;
+use lodestone_core::features::FeatureSet;
 use lodestone_core::footprint::Prepared;
 use lodestone_core::preconvolved::PreconvolvedTable;
 use serde_json::json;
@@ -73,14 +74,16 @@ fn lodestone_filtered_main(@builtin(global_invocation_id) id: vec3<u32>) {
 
 /// The self-contained WGSL snippet.
 pub fn snippet_wgsl() -> String {
+    let material = [shaders::SPECIAL, shaders::MATERIAL, shaders::IMAGE_DRIVER].join("\n");
+    // The bundle's data holds every table the material has, so the snippet is the all-features
+    // shader (the engine then picks the material at run time, as Lodestone's own fallback does).
+    let material = crate::specialize::specialize(&material, FeatureSet::all())
+        .expect("the all-features material shader specialises");
     format!(
         "// Lodestone filtered material, self-contained WGSL (lodestone-core mirrored in f32).\n\
          // Bindings: 0 = Params (params.bin), 1 = data (data.bin); see manifest.json.\n\
-         // API: eval_filtered / eval_naive / eval_view_independent(x0, fp, wo, wi) -> vec3<f32>.\n\n{}\n{}\n{}\n{}",
-        shaders::SPECIAL,
-        shaders::MATERIAL,
-        shaders::IMAGE_DRIVER,
-        EXAMPLE
+         // API: eval_filtered / eval_naive / eval_view_independent(x0, fp, wo, wi) -> vec3<f32>.\n\n{}\n{}",
+        material, EXAMPLE
     )
 }
 

@@ -12,6 +12,7 @@ pub mod gpu;
 pub mod gpu_types;
 pub mod renderer;
 pub mod shaders;
+pub mod specialize;
 
 pub use gpu::{GpuContext, GpuError};
 pub use renderer::{GpuMaterial, LinearImage, RenderError, Renderer, Scene, ViewMode, ViewTarget};

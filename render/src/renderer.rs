@@ -3,20 +3,24 @@
 
 use crate::gpu::GpuContext;
 use crate::gpu_types::GpuParams;
-use crate::shaders;
+use crate::specialize::{SpecializeError, view_source_for};
 use glam::DVec3;
 use lodestone_core::camera::{Camera, PIXEL_SIGMA};
 use lodestone_core::colormap::linear_to_srgb;
 use lodestone_core::cylinder::Shape;
 use lodestone_core::driver_field::{DriverField, TiledImage};
 use lodestone_core::effective_height::{EffectiveHeightTable, HeightFilter};
+use lodestone_core::features::{Feature, FeatureSet};
 use lodestone_core::footprint::{Prepared, hermite_rule};
 use lodestone_core::material::{ColorModel, ColorSource};
 use lodestone_core::piecewise::PiecewisePoly;
 use lodestone_core::preconvolved::PreconvolvedTable;
 use lodestone_core::shadowing::Correlation;
 use lodestone_core::transfer::TransferFunction;
+use std::collections::HashMap;
 use std::f64::consts::TAU;
+use std::sync::{Arc, Mutex, OnceLock};
+use std::time::{Duration, Instant};
 
 /// Errors while rendering.
 #[derive(Debug, thiserror::Error)]
@@ -117,6 +121,12 @@ pub struct GpuMaterial {
     data: wgpu::Buffer,
     base: GpuParams,
     target: [f64; 2],
+    /// The material's own features ([`FeatureSet::of_material`]).
+    features: FeatureSet,
+    /// Uploaded for the all-features pipeline (every table, drawn by the unspecialised shader).
+    all_features: bool,
+    /// Bytes per part of the data buffer.
+    segments: Vec<(&'static str, usize)>,
 }
 
 /// One view's render target: an accumulation buffer (linear RGB + sample count per pixel) and its
@@ -215,19 +225,75 @@ impl ViewTarget {
 #[derive(Debug)]
 pub struct Renderer {
     ctx: GpuContext,
-    pipeline: wgpu::ComputePipeline,
+    pipelines: Arc<PipelineCache>,
+    /// Threads compiling pipelines ahead of use ([`Renderer::prewarm`]); joined on drop.
+    prewarming: Mutex<Vec<std::thread::JoinHandle<()>>>,
 }
 
-/// The WGSL the view pass compiles: special functions, material model, view entry point.
+/// One compiled view pipeline per feature set. An entry's `OnceLock` is created under the map's
+/// lock and filled outside it, so different sets compile concurrently and a second request for
+/// a set being compiled waits for that compilation instead of starting another.
+#[derive(Debug, Default)]
+struct PipelineCache {
+    map: Mutex<HashMap<FeatureSet, Arc<OnceLock<Compiled>>>>,
+}
+
+/// A compiled pipeline and what it cost.
+#[derive(Debug, Clone)]
+struct Compiled {
+    pipeline: Arc<wgpu::ComputePipeline>,
+    took: Duration,
+}
+
+impl PipelineCache {
+    fn entry(&self, set: FeatureSet) -> Arc<OnceLock<Compiled>> {
+        let mut map = self.map.lock().unwrap_or_else(|e| e.into_inner());
+        map.entry(set).or_default().clone()
+    }
+
+    fn get(&self, device: &wgpu::Device, set: FeatureSet) -> Compiled {
+        self.entry(set).get_or_init(|| compile(device, set)).clone()
+    }
+
+    fn ready(&self, set: FeatureSet) -> bool {
+        let map = self.map.lock().unwrap_or_else(|e| e.into_inner());
+        map.get(&set).is_some_and(|e| e.get().is_some())
+    }
+}
+
+fn compile(device: &wgpu::Device, set: FeatureSet) -> Compiled {
+    let t0 = Instant::now();
+    // The shipped sources are checked for every feature set by a test; failing here is a bug.
+    let source = view_source_for(set).expect("the view shader specialises for every feature set");
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("view"),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("view"),
+        layout: None,
+        module: &module,
+        entry_point: Some("view_main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let took = t0.elapsed();
+    log::info!("view pipeline [{set}] compiled in {took:.1?}");
+    Compiled {
+        pipeline: Arc::new(pipeline),
+        took,
+    }
+}
+
+/// The WGSL of the all-features view pass: special functions, material model, image driver,
+/// cylinder, view entry point.
 pub fn view_source() -> String {
-    [
-        shaders::SPECIAL,
-        shaders::MATERIAL,
-        shaders::IMAGE_DRIVER,
-        shaders::CYLINDER,
-        shaders::VIEW,
-    ]
-    .join("\n")
+    view_source_for(FeatureSet::all()).expect("the all-features shader specialises")
+}
+
+/// The WGSL of the view pass specialised to `features` (see [`crate::specialize`]).
+pub fn view_source_specialized(features: FeatureSet) -> Result<String, SpecializeError> {
+    view_source_for(features)
 }
 
 fn push_table(data: &mut Vec<f32>, t: &PreconvolvedTable) -> u32 {
@@ -285,11 +351,42 @@ fn push_image(data: &mut Vec<f32>, base: &mut GpuParams, tiled: &TiledImage, tar
     base.image_lip_y = img.lipschitz.y as f32;
 }
 
-/// The material's data buffer (waves, image pyramid, tables, D_h, quadrature rule, curve polynomials, as f32) and
-/// the material part of the WGSL `Params`, with coordinates relative to `target`: each wave's phase
-/// absorbs 2π k·target in f64, so f32 phases stay accurate anywhere on the plane. Shared by the
-/// renderer and the engine bundle ([`crate::export`]).
+/// The material's data buffer and the material part of the WGSL `Params`, see [`material_data_for`]
+/// (with every table the material has: what the all-features shader reads).
 pub fn material_data(prepared: &Prepared, target: [f64; 2]) -> (Vec<f32>, GpuParams) {
+    let d = material_data_for(prepared, target, FeatureSet::all());
+    (d.data, d.params)
+}
+
+/// A material's GPU data, by part.
+#[derive(Clone, Debug)]
+pub struct MaterialData {
+    /// The data buffer (f32 words).
+    pub data: Vec<f32>,
+    /// The material part of the parameters.
+    pub params: GpuParams,
+    /// Bytes of each part present (waves, image pyramid, colour table, …).
+    pub segments: Vec<(&'static str, usize)>,
+}
+
+/// The material's data buffer (waves, image pyramid, tables, D_h, quadrature rule, curve
+/// polynomials, as f32) and the material part of the WGSL `Params`, with coordinates relative to
+/// `target`: each wave's phase absorbs 2π k·target in f64, so f32 phases stay accurate anywhere
+/// on the plane. Parts the material has but `features` does not use are left out: the D_h table
+/// and the slope quadrature rule need [`Feature::Relief`] (the colour and transfer tables, the
+/// image and the waves exist only for the materials that use them). Shared by the renderer and
+/// the engine bundle ([`crate::export`]).
+pub fn material_data_for(
+    prepared: &Prepared,
+    target: [f64; 2],
+    features: FeatureSet,
+) -> MaterialData {
+    let mut segments: Vec<(&'static str, usize)> = Vec::new();
+    let mut mark = |data: &Vec<f32>, start: usize, name: &'static str| {
+        if data.len() > start {
+            segments.push((name, (data.len() - start) * 4));
+        }
+    };
     let m = &prepared.material;
     let s = &prepared.surface;
     let mut data: Vec<f32> = Vec::new();
@@ -298,6 +395,7 @@ pub fn material_data(prepared: &Prepared, target: [f64; 2]) -> (Vec<f32>, GpuPar
         ..Layout::default()
     };
     let mut base = GpuParams::default();
+    let start = data.len();
     match &s.driver {
         DriverField::Noise(noise) => {
             for w in &noise.waves {
@@ -309,8 +407,18 @@ pub fn material_data(prepared: &Prepared, target: [f64; 2]) -> (Vec<f32>, GpuPar
         }
         DriverField::Image(tiled) => push_image(&mut data, &mut base, tiled, target),
     }
+    mark(
+        &data,
+        start,
+        match s.driver {
+            DriverField::Noise(_) => "noise waves",
+            DriverField::Image(_) => "image pyramid",
+        },
+    );
     if let Some(t) = &prepared.color_table {
+        let start = data.len();
         lay.color_table = push_table(&mut data, t);
+        mark(&data, start, "colour table");
         base.ct_size_m = t.size_m as u32;
         base.ct_size_s = t.size_sigma as u32;
         base.ct_m_min = t.m_min as f32;
@@ -318,7 +426,9 @@ pub fn material_data(prepared: &Prepared, target: [f64; 2]) -> (Vec<f32>, GpuPar
         base.ct_sigma_max = t.sigma_max as f32;
     }
     if let Some(t) = &prepared.transfer_table {
+        let start = data.len();
         lay.transfer_table = push_table(&mut data, t);
+        mark(&data, start, "transfer table");
         base.tt_size_m = t.size_m as u32;
         base.tt_size_s = t.size_sigma as u32;
         base.tt_m_min = t.m_min as f32;
@@ -326,20 +436,28 @@ pub fn material_data(prepared: &Prepared, target: [f64; 2]) -> (Vec<f32>, GpuPar
         base.tt_sigma_max = t.sigma_max as f32;
     }
     let dh = EffectiveHeightTable::shared();
-    lay.dh = data.len() as u32;
-    for (a, b) in dh.mean.iter().zip(&dh.std) {
-        data.extend([*a as f32, *b as f32]);
-    }
     let points = m.filtering.slope_points.max(1) as usize;
-    let (x, w) = hermite_rule(points);
-    lay.gh = data.len() as u32;
-    for (a, b) in x.iter().zip(w) {
-        data.extend([*a as f32, *b as f32]);
+    if features.contains(Feature::Relief) {
+        let start = data.len();
+        lay.dh = data.len() as u32;
+        for (a, b) in dh.mean.iter().zip(&dh.std) {
+            data.extend([*a as f32, *b as f32]);
+        }
+        mark(&data, start, "visible-height table D_h");
+        let start = data.len();
+        let (x, w) = hermite_rule(points);
+        lay.gh = data.len() as u32;
+        for (a, b) in x.iter().zip(w) {
+            data.extend([*a as f32, *b as f32]);
+        }
+        mark(&data, start, "slope quadrature rule");
     }
     match &m.color {
         ColorModel::Gradient { map, source } => {
             let p = map.to_piecewise();
+            let start = data.len();
             lay.color_poly = push_poly(&mut data, &p, &[0, 1, 2]);
+            mark(&data, start, "colour map polynomial");
             base.cp_knots = p.knots.len() as u32;
             base.color_kind = match source {
                 ColorSource::Driver => 0,
@@ -354,7 +472,9 @@ pub fn material_data(prepared: &Prepared, target: [f64; 2]) -> (Vec<f32>, GpuPar
     }
     if let TransferFunction::Curve(c) = &m.heights.transfer {
         let p = c.moment_poly();
+        let start = data.len();
         lay.transfer_poly = push_poly(&mut data, &p, &[0, 2]);
+        mark(&data, start, "transfer polynomial");
         base.tp_knots = p.knots.len() as u32;
         base.transfer_kind = 1;
     }
@@ -384,14 +504,49 @@ pub fn material_data(prepared: &Prepared, target: [f64; 2]) -> (Vec<f32>, GpuPar
     base.height_filter = u32::from(m.filtering.height_filter == HeightFilter::PaperFit);
     base.g_mean = prepared.g_global.0 as f32;
     base.g_std = prepared.g_global.1 as f32;
-    (data, base)
+    MaterialData {
+        data,
+        params: base,
+        segments,
+    }
 }
 
 impl GpuMaterial {
-    /// Upload a prepared material with coordinates relative to `target` (the camera target), see
-    /// [`material_data`].
+    /// Upload a prepared material with coordinates relative to `target` (the camera target), with
+    /// only the data its features use ([`material_data_for`]); drawn by pipelines specialised to
+    /// the material and scene.
     pub fn new(ctx: &GpuContext, prepared: &Prepared, target: [f64; 2]) -> Self {
-        let (data, base) = material_data(prepared, target);
+        let features = FeatureSet::of_material(&prepared.material);
+        Self::upload(ctx, prepared, target, features, false)
+    }
+
+    /// Upload every table the material has, to be drawn by the all-features pipeline (the
+    /// reference the specialised pipelines are compared against, and the engine bundle's shader).
+    pub fn all_features(ctx: &GpuContext, prepared: &Prepared, target: [f64; 2]) -> Self {
+        let features = FeatureSet::of_material(&prepared.material);
+        Self::upload(ctx, prepared, target, features, true)
+    }
+
+    fn upload(
+        ctx: &GpuContext,
+        prepared: &Prepared,
+        target: [f64; 2],
+        features: FeatureSet,
+        all_features: bool,
+    ) -> Self {
+        let uses = if all_features {
+            FeatureSet::all()
+        } else {
+            features
+        };
+        let MaterialData {
+            mut data,
+            params,
+            segments,
+        } = material_data_for(prepared, target, uses);
+        if data.is_empty() {
+            data.push(0.0);
+        }
         let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("material data"),
             size: (data.len() * 4) as u64,
@@ -402,8 +557,11 @@ impl GpuMaterial {
             .write_buffer(&buffer, 0, bytemuck::cast_slice(&data));
         Self {
             data: buffer,
-            base,
+            base: params,
             target,
+            features,
+            all_features,
+            segments,
         }
     }
 
@@ -411,28 +569,92 @@ impl GpuMaterial {
     pub fn target(&self) -> [f64; 2] {
         self.target
     }
+
+    /// The material's own features.
+    pub fn features(&self) -> FeatureSet {
+        self.features
+    }
+
+    /// Bytes of each part of the uploaded data.
+    pub fn segments(&self) -> &[(&'static str, usize)] {
+        &self.segments
+    }
+
+    /// The feature set of the pipeline that draws this material in `scene`: the material's
+    /// features completed by the scene's, or every feature for [`GpuMaterial::all_features`].
+    pub fn pipeline_features(&self, scene: &Scene) -> FeatureSet {
+        if self.all_features {
+            FeatureSet::all()
+        } else {
+            self.features
+                .in_scene(scene.shape, scene.light.normalize())
+                .normalized()
+        }
+    }
+}
+
+impl Drop for Renderer {
+    /// Waits for pipelines still compiling ahead of use, so no thread holds the device after its
+    /// renderer is gone (a thread tearing down an llvmpipe device during process exit corrupted
+    /// the heap once).
+    fn drop(&mut self) {
+        let threads = std::mem::take(self.prewarming.get_mut().unwrap_or_else(|e| e.into_inner()));
+        for t in threads {
+            if t.join().is_err() {
+                log::error!("a pipeline compilation thread panicked");
+            }
+        }
+    }
 }
 
 impl Renderer {
-    /// Compile the view pipeline on `ctx`.
+    /// A renderer on `ctx`. Pipelines are compiled on first use, one per feature set, and cached
+    /// ([`Renderer::prewarm`] compiles them ahead of use on another thread).
     pub fn new(ctx: GpuContext) -> Self {
-        let module = ctx
-            .device
-            .create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("view"),
-                source: wgpu::ShaderSource::Wgsl(view_source().into()),
+        Self {
+            ctx,
+            pipelines: Arc::default(),
+            prewarming: Mutex::new(Vec::new()),
+        }
+    }
+
+    /// The pipeline for `features`, compiling it now if needed; returns how long that
+    /// compilation took (zero when it was cached).
+    pub fn prepare(&self, features: FeatureSet) -> Duration {
+        let cached = self.pipelines.ready(features);
+        let c = self.pipelines.get(&self.ctx.device, features);
+        if cached { Duration::ZERO } else { c.took }
+    }
+
+    /// Whether the pipeline for `features` is compiled.
+    pub fn is_ready(&self, features: FeatureSet) -> bool {
+        self.pipelines.ready(features)
+    }
+
+    /// Compile the pipelines for `sets` on a background thread (those not cached yet), so that a
+    /// later [`Renderer::draw`] needing one does not wait. Finished threads are reaped here.
+    pub fn prewarm(&self, sets: Vec<FeatureSet>) {
+        let missing: Vec<_> = sets
+            .into_iter()
+            .filter(|s| !self.pipelines.ready(*s))
+            .collect();
+        let mut threads = self.prewarming.lock().unwrap_or_else(|e| e.into_inner());
+        threads.retain(|t| !t.is_finished());
+        if missing.is_empty() {
+            return;
+        }
+        let (device, cache) = (self.ctx.device.clone(), self.pipelines.clone());
+        let spawned = std::thread::Builder::new()
+            .name("lodestone-pipelines".into())
+            .spawn(move || {
+                for s in missing {
+                    cache.get(&device, s);
+                }
             });
-        let pipeline = ctx
-            .device
-            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("view"),
-                layout: None,
-                module: &module,
-                entry_point: Some("view_main"),
-                compilation_options: Default::default(),
-                cache: None,
-            });
-        Self { ctx, pipeline }
+        match spawned {
+            Ok(t) => threads.push(t),
+            Err(e) => log::warn!("cannot compile pipelines ahead of use: {e}"),
+        }
     }
 
     /// The GPU context.
@@ -467,6 +689,10 @@ impl Renderer {
         samples: u32,
     ) {
         let (width, height) = (target.width, target.height);
+        let pipeline = self
+            .pipelines
+            .get(&self.ctx.device, material.pipeline_features(scene))
+            .pipeline;
         let mut params = material.base;
         let cam = Camera {
             target: [0.0, 0.0],
@@ -497,7 +723,7 @@ impl Renderer {
             .device
             .create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("view"),
-                layout: &self.pipeline.get_bind_group_layout(0),
+                layout: &pipeline.get_bind_group_layout(0),
                 entries: &[
                     wgpu::BindGroupEntry {
                         binding: 0,
@@ -538,7 +764,7 @@ impl Renderer {
                     label: Some("view"),
                     timestamp_writes: None,
                 });
-                pass.set_pipeline(&self.pipeline);
+                pass.set_pipeline(&pipeline);
                 pass.set_bind_group(0, &bind, &[]);
                 pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
             }

@@ -1,4 +1,8 @@
 //! WGSL sources. Every file is listed in [`ALL`] so one test validates them all with naga.
+//!
+//! The sources carry `//#if feature` directives (see [`crate::specialize`]): use them through
+//! [`crate::specialize::specialize`] (with [`FeatureSet::all`](lodestone_core::features::FeatureSet::all)
+//! for the all-features shader), never raw.
 
 /// f32 special functions, mirroring `lodestone_core::special_f32`.
 pub const SPECIAL: &str = include_str!("shaders/special.wgsl");

@@ -1,6 +1,7 @@
 //! Every WGSL file validates with naga, and the WGSL mirrors agree with lodestone-core on the GPU
 //! adapter (llvmpipe on CI) over ≥ 10,000 inputs, extremes included.
 
+use lodestone_core::features::FeatureSet;
 use lodestone_core::{special, special_f32};
 use lodestone_render::{GpuContext, compute::eval_unary, shaders};
 
@@ -8,7 +9,8 @@ use lodestone_render::{GpuContext, compute::eval_unary, shaders};
 fn module_for(name: &str, file: &str) -> naga::Module {
     let mut parts = shaders::prelude_for(name);
     parts.push(file);
-    let src = parts.join("\n");
+    let src = lodestone_render::specialize::specialize(&parts.join("\n"), FeatureSet::all())
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
     let module = naga::front::wgsl::parse_str(&src)
         .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(&src)));
     naga::valid::Validator::new(

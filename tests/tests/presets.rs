@@ -1,45 +1,12 @@
 //! Every preset in presets/ loads, validates, round-trips (load → save → load gives an equal value),
 //! evaluates finite on the CPU and renders under every mode on the GPU adapter.
 
-use lodestone_core::footprint::{Config, Prepared};
-use lodestone_core::image_driver::ImageDriver;
-use lodestone_core::material::{Driver, Material};
+use lodestone_core::footprint::Config;
+use lodestone_core::material::Material;
 use lodestone_core::smith::direction;
-use std::sync::Arc;
 
-/// Prepare a preset, decoding its driver image (relative to presets/) when it has one.
-fn prepare(path: &str, m: &Material) -> Prepared {
-    let image = match &m.driver {
-        Driver::Image { path: img, .. } => {
-            let file = std::path::Path::new(path).parent().unwrap().join(img);
-            let luma = image::open(&file)
-                .unwrap_or_else(|e| panic!("{path}: driver image {}: {e}", file.display()))
-                .to_luma32f();
-            let (w, h) = luma.dimensions();
-            Some(Arc::new(
-                ImageDriver::new(w as usize, h as usize, luma.as_raw()).unwrap(),
-            ))
-        }
-        Driver::Noise(_) => None,
-    };
-    Prepared::with_image(m, image, None).unwrap_or_else(|e| panic!("{path}: {e}"))
-}
-
-fn presets() -> Vec<(String, String)> {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../presets");
-    let mut out = vec![];
-    for entry in std::fs::read_dir(&dir).expect("presets/ exists") {
-        let path = entry.unwrap().path();
-        if path.extension().is_some_and(|e| e == "ron") {
-            out.push((
-                path.display().to_string(),
-                std::fs::read_to_string(&path).unwrap(),
-            ));
-        }
-    }
-    out.sort();
-    out
-}
+mod common;
+use common::{prepare, presets};
 
 #[test]
 fn every_preset_loads_validates_and_round_trips() {

@@ -3,11 +3,15 @@
 // footprint.rs, function for function under the same names (prefixes only where WGSL needs them).
 // Needs special.wgsl before it. All positions are relative to the camera target (the CPU folds
 // 2π k·target into each wave's phase in f64), which keeps f32 phases accurate far from the origin.
+// `//#if feature` blocks are removed when a scene does not use the feature (specialize.rs); this
+// file as written is the all-features shader only after specialize() has stripped the directives.
 
 const PI: f32 = 3.14159265;
 const TAU: f32 = 6.2831853;
 const FRAC_1_PI: f32 = 0.31830988;
 const SQRT_2: f32 = 1.4142135;
+// Over-relaxation of the sphere-tracing marches (surface::RELAXATION).
+const RELAXATION: f32 = 1.6;
 
 // Flat parameter block; kept in sync with `GpuParams` in gpu_types.rs by a layout test.
 struct Params {
@@ -84,6 +88,7 @@ fn texel4(off: u32, i: u32) -> vec4<f32> {
     return vec4<f32>(data[b], data[b + 1u], data[b + 2u], data[b + 3u]);
 }
 
+//#if driver_color|height_color|transfer_curve
 // (i0, i1, blend) of a continuous texel coordinate, clamped (mirror of preconvolved::split).
 fn split_coord(f_in: f32, n: u32) -> vec3<f32> {
     let f = clamp(f_in, 0.0, f32(n - 1u));
@@ -103,8 +108,10 @@ fn table_sample(off: u32, nm: u32, ns: u32, m_min: f32, m_max: f32, sigma_max: f
     let bot = mix(texel4(off, j1 * nm + i0), texel4(off, j1 * nm + i1), u.z);
     return mix(top, bot, v.z);
 }
+//#endif
 
 // ---------------------------------------------------------------- effective_height.rs
+//#if relief
 // EffectiveHeightTable::lookup (x = mean, y = std), or the paper's fits [HNPN14 Eqs. 16–17].
 fn height_moments(l_in: f32) -> vec2<f32> {
     let l = max(l_in, 0.0);
@@ -126,8 +133,10 @@ fn height_moments(l_in: f32) -> vec2<f32> {
     let b = vec2<f32>(data[off + 2u * i + 2u], data[off + 2u * i + 3u]);
     return mix(a, b, f);
 }
+//#endif
 
 // ---------------------------------------------------------------- piecewise.rs (eval, degree ≤ 3)
+//#if driver_color|height_color|transfer_curve
 // Layout at `off`: knots[k], then per segment per channel 4 coefficients, then left[ch], right[ch].
 fn poly_eval(off: u32, k: u32, channels: u32, ch: u32, x: f32) -> f32 {
     let coeff = off + k;
@@ -151,6 +160,7 @@ fn poly_eval(off: u32, k: u32, channels: u32, ch: u32, x: f32) -> f32 {
     let c = coeff + 4u * (seg * channels + ch);
     return ((data[c + 3u] * t + data[c + 2u]) * t + data[c + 1u]) * t + data[c];
 }
+//#endif
 
 // ---------------------------------------------------------------- noise.rs
 struct FilteredDriver {
@@ -160,16 +170,21 @@ struct FilteredDriver {
     gradient_cov: vec3<f32>, // xx, yy, xy
 }
 
+//#if noise
 fn wave(i: u32) -> vec4<f32> {
     return texel4(params.waves_offset, i);
 }
+//#endif
 
 // DriverField::value_and_gradient: (f, ∂f/∂x, ∂f/∂y) of the noise (SumOfSines) or the image.
 fn value_and_gradient(x: vec2<f32>) -> vec3<f32> {
+//#if image
     if (params.driver_kind == 1u) {
         let v = image_value_and_gradient(image_texel(x));
         return vec3<f32>(v.x, v.yz * params.image_scale);
     }
+//#endif
+//#if noise
     var v = 0.0;
     var g = vec2<f32>(0.0);
     for (var i = 0u; i < params.wave_count; i = i + 1u) {
@@ -179,18 +194,24 @@ fn value_and_gradient(x: vec2<f32>) -> vec3<f32> {
         g = g - w.xy * (w.z * TAU * sin(ph));
     }
     return vec3<f32>(v, g);
+//#else
+    return vec3<f32>(0.0);
+//#endif
 }
 
 // DriverField::filtered (SumOfSines::filtered for the noise) with footprint covariance (xx, yy, xy).
 fn filtered_driver(x: vec2<f32>, fp: vec3<f32>) -> FilteredDriver {
+//#if image
     if (params.driver_kind == 1u) {
         return image_filtered_driver(x, fp);
     }
+//#endif
     var r: FilteredDriver;
     r.mean = 0.0;
     r.mean_gradient = vec2<f32>(0.0);
     r.gradient_cov = vec3<f32>(0.0);
     var var_sum = 0.0;
+//#if noise
     for (var i = 0u; i < params.wave_count; i = i + 1u) {
         let w = wave(i);
         let q = w.x * w.x * fp.x + 2.0 * w.x * w.y * fp.z + w.y * w.y * fp.y;
@@ -202,6 +223,7 @@ fn filtered_driver(x: vec2<f32>, fp: vec3<f32>) -> FilteredDriver {
         var_sum = var_sum + u;
         r.gradient_cov = r.gradient_cov + vec3<f32>(w.x * w.x, w.y * w.y, w.x * w.y) * (u * TAU * TAU);
     }
+//#endif
     r.std_dev = sqrt(max(var_sum, 0.0));
     return r;
 }
@@ -209,19 +231,23 @@ fn filtered_driver(x: vec2<f32>, fp: vec3<f32>) -> FilteredDriver {
 // ---------------------------------------------------------------- transfer.rs
 // TransferFunction::eval and ::derivative: (g, g′). Identity when transfer_kind == 0.
 fn transfer_eval(f: f32) -> vec2<f32> {
-    if (params.transfer_kind == 0u) {
-        return vec2<f32>(f, 1.0);
+//#if transfer_curve
+    if (params.transfer_kind != 0u) {
+        return vec2<f32>(poly_eval(params.tp_offset, params.tp_knots, 2u, 0u, f), poly_eval(params.tp_offset, params.tp_knots, 2u, 1u, f));
     }
-    return vec2<f32>(poly_eval(params.tp_offset, params.tp_knots, 2u, 0u, f), poly_eval(params.tp_offset, params.tp_knots, 2u, 1u, f));
+//#endif
+    return vec2<f32>(f, 1.0);
 }
 
 // Moments (ḡ, σ_g, ḡ′, σ_g′) [HNPN14 Eqs. 21–28], from the table for curves.
 fn transfer_moments(m: f32, s: f32) -> vec4<f32> {
-    if (params.transfer_kind == 0u) {
-        return vec4<f32>(m, max(s, 0.0), 1.0, 0.0);
+//#if transfer_curve
+    if (params.transfer_kind != 0u) {
+        let v = table_sample(params.tt_offset, params.tt_size_m, params.tt_size_s, params.tt_m_min, params.tt_m_max, params.tt_sigma_max, m, s);
+        return vec4<f32>(v.x, max(v.y, 0.0), v.z, max(v.w, 0.0));
     }
-    let v = table_sample(params.tt_offset, params.tt_size_m, params.tt_size_s, params.tt_m_min, params.tt_m_max, params.tt_sigma_max, m, s);
-    return vec4<f32>(v.x, max(v.y, 0.0), v.z, max(v.w, 0.0));
+//#endif
+    return vec4<f32>(m, max(s, 0.0), 1.0, 0.0);
 }
 
 struct SurfaceStats {
@@ -245,6 +271,7 @@ fn transformed_statistics(tm: vec4<f32>, sigma_h: f32, grad_mean: vec2<f32>, gra
 }
 
 // ---------------------------------------------------------------- smith.rs / shadowing.rs
+//#if relief
 fn cot_theta(w: vec3<f32>) -> f32 {
     if (!(w.z > 0.0)) {
         return 0.0;
@@ -306,8 +333,10 @@ fn masking(wo: vec3<f32>, wi: vec3<f32>, cov: vec3<f32>) -> vec4<f32> {
 fn mean_shadowing(m: vec4<f32>) -> f32 {
     return 1.0 / (1.0 + m.z / (1.0 + m.x));
 }
+//#endif
 
 // ---------------------------------------------------------------- attribute.rs
+//#if attribute_color
 fn attribute_shape(t: f32) -> f32 {
     return erf(t * FRAC_1_SQRT_2);
 }
@@ -315,6 +344,7 @@ fn attribute_shape(t: f32) -> f32 {
 fn mean_attribute_shape(l: f32) -> f32 {
     return 1.0 - 2.0 / (max(l, 0.0) + 2.0);
 }
+//#endif
 
 // ---------------------------------------------------------------- brdf.rs
 fn slope_of(n: vec3<f32>) -> vec2<f32> {
@@ -325,6 +355,7 @@ fn normal_of(s: vec2<f32>) -> vec3<f32> {
     return normalize(vec3<f32>(-s.x, -s.y, 1.0));
 }
 
+//#if specular
 fn gaussian2(d: vec2<f32>, c: vec3<f32>) -> f32 {
     let xx = max(c.x, 1e-14);
     let yy = max(c.y, 1e-14);
@@ -332,8 +363,10 @@ fn gaussian2(d: vec2<f32>, c: vec3<f32>) -> f32 {
     let q = (yy * d.x * d.x - 2.0 * c.z * d.x * d.y + xx * d.y * d.y) / det;
     return exp(-0.5 * q) / (TAU * sqrt(det));
 }
+//#endif
 
 fn specular_with(n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, extra: vec3<f32>) -> f32 {
+//#if specular
     if (params.specular <= 0.0 || dot(n, wi) <= 0.0 || dot(n, wo) <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0) {
         return 0.0;
     }
@@ -344,6 +377,9 @@ fn specular_with(n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, extra: vec3<f32>) -
     let s0 = max(params.roughness, 0.0);
     let d = gaussian2(slope_of(h) - slope_of(n), extra + vec3<f32>(s0 * s0, s0 * s0, 0.0));
     return params.specular * d / (4.0 * pow(h.z, 4.0) * wo.z);
+//#else
+    return 0.0;
+//#endif
 }
 
 // BaseBrdf::shade.
@@ -354,6 +390,7 @@ fn shade(color: vec3<f32>, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f
 }
 
 // ---------------------------------------------------------------- footprint.rs
+//#if relief
 fn cholesky(c: vec3<f32>) -> vec3<f32> {
     let l11 = sqrt(max(c.x, 0.0));
     var l21 = 0.0;
@@ -389,9 +426,11 @@ fn visible_slope_mean_cos(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: ve
     }
     return 0.0;
 }
+//#endif
 
 // footprint::filtered_specular (world slope space, facet slopes N(mean, cov)).
 fn filtered_specular(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+//#if specular
     if (params.specular <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0) {
         return 0.0;
     }
@@ -422,8 +461,12 @@ fn filtered_specular(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f3
     let eu = expected_positive_part(wo.z, wo.xy, mean, cov);
     let dens = gaussian2(sh - mean, total);
     return params.specular * dens * (u_post / max(eu, 1e-30)) / (4.0 * pow(h.z, 4.0) * wo.z);
+//#else
+    return 0.0;
+//#endif
 }
 
+//#if specular
 // footprint::expected_positive_part: E[(a − s·b)⁺] for s ~ N(mean, cov).
 fn expected_positive_part(a: f32, b: vec2<f32>, mean: vec2<f32>, cov: vec3<f32>) -> f32 {
     let m = a - dot(mean, b);
@@ -435,6 +478,7 @@ fn expected_positive_part(a: f32, b: vec2<f32>, mean: vec2<f32>, cov: vec3<f32>)
     }
     return max(m, 0.0);
 }
+//#endif
 
 // Prepared::point_input: (colour-map input, standardized height) at driver value f.
 fn point_input(f: f32) -> vec2<f32> {
@@ -448,23 +492,35 @@ fn point_input(f: f32) -> vec2<f32> {
 // Prepared::color_at.
 fn color_at(f: f32) -> vec3<f32> {
     let it = point_input(f);
+//#if attribute_color
     if (params.color_kind == 2u) {
         let s = attribute_shape(it.y);
         return max(params.attr_mean + params.attr_corr * s, vec3<f32>(0.0));
     }
+//#endif
+//#if driver_color|height_color
     let k = params.cp_knots;
     return vec3<f32>(poly_eval(params.cp_offset, k, 3u, 0u, it.x), poly_eval(params.cp_offset, k, 3u, 1u, it.x), poly_eval(params.cp_offset, k, 3u, 2u, it.x));
+//#else
+    return vec3<f32>(0.0);
+//#endif
 }
 
 // Prepared::color_of_distribution.
 fn color_of_distribution(mean: f32, sd: f32, l: f32, far: vec2<f32>, w: f32) -> vec3<f32> {
+//#if attribute_color
     if (params.color_kind == 2u) {
         let g = erf(mean / sqrt(2.0 * (1.0 + sd * sd)));
         let gf = erf(far.x / sqrt(2.0 * (1.0 + far.y * far.y)));
         let s = g + clamp(w, 0.0, 1.0) * (mean_attribute_shape(l) - gf);
         return max(params.attr_mean + params.attr_corr * s, vec3<f32>(0.0));
     }
+//#endif
+//#if driver_color|height_color
     return table_sample(params.ct_offset, params.ct_size_m, params.ct_size_s, params.ct_m_min, params.ct_m_max, params.ct_sigma_max, mean, sd).xyz;
+//#else
+    return vec3<f32>(0.0);
+//#endif
 }
 
 struct Local {
@@ -509,6 +565,7 @@ fn eval_view_independent(x0: vec2<f32>, fp: vec3<f32>, wo: vec3<f32>, wi: vec3<f
     return shade(c, n, wo, wi) * lit(wi, n);
 }
 
+//#if relief
 // footprint::basis (Duff et al. 2017).
 fn basis_t(n: vec3<f32>) -> vec3<f32> {
     let sign = select(-1.0, 1.0, n.z >= 0.0);
@@ -523,10 +580,12 @@ fn basis_b(n: vec3<f32>) -> vec3<f32> {
     let b = n.x * n.y * a;
     return vec3<f32>(b, sign + n.y * n.y * a, -n.y);
 }
+//#endif
 
 // Prepared::filtered.
 fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>) -> vec3<f32> {
     let loc = local_stats(x0, fp);
+//#if relief
     let nbar = normal_of(loc.stats.slope_mean);
     let t = basis_t(nbar);
     let b = basis_b(nbar);
@@ -542,6 +601,8 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>)
     let color = color_of_distribution(d.x + d.y * hm.x, d.y * hm.y, ms.w, hm, d.y * d.y);
     var vbar = 0.0;
     if (wi.z > 0.0 && wi_w.z > 0.0) {
+        // Kept without the shadows feature: a light at the world normal is oblique to a tilted
+        // mean normal, so Λ(ω_i) need not be 0 in the footprint's frame.
         vbar = mean_shadowing(ms);
     }
     // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
@@ -549,22 +610,42 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>)
     let diffuse = params.albedo * FRAC_1_PI * visible_slope_mean_cos(s_mean, cov, wo_w, wi_w);
     let spec = filtered_specular(s_mean, cov, wo_w, wi_w);
     return vbar * (color * diffuse + vec3<f32>(spec));
+//#else
+    // Flat: every facet faces +z, nothing masks or shadows (Λ = 0, and D_h at L = 0 is the
+    // identity, so the colour is that of the footprint's own distribution).
+    if (wo_w.z <= 0.0 || wi_w.z <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let d = input_distribution(loc);
+    let color = color_of_distribution(d.x, d.y, 0.0, vec2<f32>(0.0, 1.0), d.y * d.y);
+    let diffuse = params.albedo * FRAC_1_PI * wi_w.z;
+    let spec = filtered_specular(vec2<f32>(0.0), vec3<f32>(0.0), wo_w, wi_w);
+    return color * diffuse + vec3<f32>(spec);
+//#endif
 }
 
 // ---------------------------------------------------------------- surface.rs (ground truth)
+//#if relief|curved
 fn surface_height(x: vec2<f32>) -> f32 {
     return params.sigma_h * transfer_eval(value_and_gradient(x).x).x;
 }
 
+//#endif
+
+//#if relief
 fn lipschitz_along(dir: vec2<f32>) -> f32 {
+//#if image
     if (params.driver_kind == 1u) {
         return params.sigma_h * params.g_lip * image_lipschitz_along(dir);
     }
+//#endif
     var s = 0.0;
+//#if noise
     for (var i = 0u; i < params.wave_count; i = i + 1u) {
         let w = wave(i);
         s = s + abs(w.z) * TAU * abs(dot(w.xy, dir));
     }
+//#endif
     return params.sigma_h * params.g_lip * s;
 }
 
@@ -580,7 +661,6 @@ fn field_height(x: vec2<f32>, lod: bool, sf: f32) -> f32 {
 // surface::march_heightfield (over-relaxed; backs off when the safe intervals of two points do not
 // cover the step, before concluding anything at the new point): t of the first crossing, or -1 when
 // the ray leaves the slab.
-const RELAXATION: f32 = 1.6;
 
 fn march_heightfield(o: vec3<f32>, d: vec3<f32>, rate: f32, lod: bool, sf: f32) -> f32 {
     if (!(rate > 0.0)) {
@@ -652,12 +732,14 @@ fn sees(p: vec3<f32>, d: vec3<f32>) -> bool {
     }
     return march(p, d) < 0.0;
 }
+//#endif
 
 // Prepared::trace_pixel_sample for a camera ray (origin, unit direction).
 fn trace_ray(origin: vec3<f32>, dir: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
     if (dir.z >= 0.0) {
         return vec3<f32>(0.0);
     }
+//#if relief
     // Start on the top of the slab.
     let top = params.h_max * 1.001 + 1e-6;
     let t0 = max((origin.z - top) / -dir.z, 0.0);
@@ -670,29 +752,48 @@ fn trace_ray(origin: vec3<f32>, dir: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
     let fg = value_and_gradient(p.xy);
     let gd = transfer_eval(fg.x);
     let n = normal_of(fg.yz * (params.sigma_h * gd.y));
-    if (dot(n, wi) <= 0.0 || wi.z <= 0.0 || !sees(p, wi)) {
+//#else
+    // Flat: the plane z = 0, facing +z everywhere.
+    let p = origin + dir * (-origin.z / dir.z);
+    let fg = value_and_gradient(p.xy);
+    let n = vec3<f32>(0.0, 0.0, 1.0);
+//#endif
+    if (dot(n, wi) <= 0.0 || wi.z <= 0.0) {
         return vec3<f32>(0.0);
     }
+//#if shadows
+    if (!sees(p, wi)) {
+        return vec3<f32>(0.0);
+    }
+//#endif
     return shade(color_at(fg.x), n, -dir, wi);
 }
 
 // ---------------------------------------------------------------- footprint.rs (level-of-detail surface)
+//#if relief
 // Per-invocation cache of each wave's footprint attenuation exp(−2π² kᵀΣk): constant along a pixel's
 // rays, so the march evaluates only cosines per step. Filled by lod_prepare (MAX_COMPONENTS = 256).
+//#if noise
 var<private> lod_att: array<f32, 256>;
+//#endif
+//#if image
 // The image's probe plan for the pixel's footprint (set by lod_prepare).
 var<private> lod_plan: ProbePlan;
+//#endif
 
 // Fill lod_att (or lod_plan) for footprint fp; returns the position-averaged footprint std σ_f
 // (DriverField::lod_moments).
 fn lod_prepare(fp: vec3<f32>) -> f32 {
+//#if image
     if (params.driver_kind == 1u) {
         let cov = fp * (params.image_scale * params.image_scale);
         lod_plan = image_plan(cov);
         let area = sqrt(sqrt(max(cov.x * cov.y - cov.z * cov.z, 0.0)));
         return image_mean_std(lod_for_std(area));
     }
+//#endif
     var v = 0.0;
+//#if noise
     for (var i = 0u; i < params.wave_count; i = i + 1u) {
         let w = wave(i);
         let q = w.x * w.x * fp.x + 2.0 * w.x * w.y * fp.z + w.y * w.y * fp.y;
@@ -700,19 +801,24 @@ fn lod_prepare(fp: vec3<f32>) -> f32 {
         lod_att[i] = g;
         v = v + w.z * w.z * (1.0 - g * g) * 0.5;
     }
+//#endif
     return sqrt(max(v, 0.0));
 }
 
 // f̄(x) with the cached attenuations.
 fn lod_mean(x: vec2<f32>) -> f32 {
+//#if image
     if (params.driver_kind == 1u) {
         return image_footprint_mean(image_texel(x), lod_plan);
     }
+//#endif
     var m = 0.0;
+//#if noise
     for (var i = 0u; i < params.wave_count; i = i + 1u) {
         let w = wave(i);
         m = m + w.z * lod_att[i] * cos(TAU * dot(w.xy, x) + w.w);
     }
+//#endif
     return m;
 }
 
@@ -727,13 +833,17 @@ fn lod_rate(d: vec3<f32>) -> f32 {
     var k = 0.0;
     if (r > 0.0) {
         let dir = d.xy / r;
+//#if image
         if (params.driver_kind == 1u) {
             k = image_lipschitz_along(dir);
         }
+//#endif
+//#if noise
         for (var i = 0u; i < params.wave_count; i = i + 1u) {
             let w = wave(i);
             k = k + abs(w.z) * lod_att[i] * TAU * abs(dot(w.xy, dir));
         }
+//#endif
         k = k * params.sigma_h * params.g_lip;
     }
     return abs(d.z) + k * r;
@@ -743,12 +853,14 @@ fn lod_rate(d: vec3<f32>) -> f32 {
 fn lod_march(o: vec3<f32>, d: vec3<f32>, sf: f32) -> f32 {
     return march_heightfield(o, d, lod_rate(d), true, sf);
 }
+//#endif
 
 // Prepared::pixel: method 0 naive, 1 view-independent, 2 filtered.
 fn analytic_pixel(method: u32, origin: vec3<f32>, dir: vec3<f32>, wi: vec3<f32>, fp: vec3<f32>) -> vec3<f32> {
     if (dir.z >= 0.0) {
         return vec3<f32>(0.0);
     }
+//#if relief
     let sf = lod_prepare(fp);
     let top = params.h_max * 1.001 + 1e-6;
     let t0 = max((origin.z - top) / -dir.z, 0.0);
@@ -758,9 +870,18 @@ fn analytic_pixel(method: u32, origin: vec3<f32>, dir: vec3<f32>, wi: vec3<f32>,
         return vec3<f32>(0.0);
     }
     let p = o + dir * t;
-    if (wi.z <= 0.0 || lod_march(p, wi, sf) >= 0.0) {
+//#else
+    // Flat: the plane z = 0.
+    let p = origin + dir * (-origin.z / dir.z);
+//#endif
+    if (wi.z <= 0.0) {
         return vec3<f32>(0.0);
     }
+//#if shadows
+    if (lod_march(p, wi, sf) >= 0.0) {
+        return vec3<f32>(0.0);
+    }
+//#endif
     if (method == 0u) {
         return eval_naive(p.xy, fp, -dir, wi);
     } else if (method == 1u) {

@@ -1,4 +1,5 @@
-// One view of the plane or cylinder scene: a compute pass over the image. Needs special.wgsl and material.wgsl.
+// One view of the plane or cylinder scene: a compute pass over the image. Needs special.wgsl and material.wgsl
+// (and cylinder.wgsl for curved scenes: its branches are `//#if curved`, see specialize.rs).
 // Modes: 0 naive MIP, 1 view-independent filtering, 2 filtered, 3 ground truth (progressive: one
 // low-discrepancy, Gaussian-filtered sub-pixel ray per pixel per frame; alpha counts samples).
 
@@ -55,6 +56,7 @@ fn view_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let idx = gid.y * params.width + gid.x;
     let centre = vec2<f32>(f32(gid.x) + 0.5, f32(gid.y) + 0.5);
     let wi = params.light;
+//#if curved
     if (params.shape == 1u) {
         if (params.mode < 3u) {
             let dx = params.right * (2.0 * params.tan_half_fov * params.aspect / f32(params.width));
@@ -63,6 +65,9 @@ fn view_main(@builtin(global_invocation_id) gid: vec3<u32>) {
             return;
         }
     } else if (params.mode < 3u) {
+//#else
+    if (params.mode < 3u) {
+//#endif
         let fp = plane_footprint(centre);
         var c = vec3<f32>(0.0);
         if (fp.hit) {
@@ -84,11 +89,15 @@ fn view_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let off = vec2<f32>(rad * cos(TAU * u2), rad * sin(TAU * u2));
     let d = normalize(raw_dir(centre + off));
     var c: vec3<f32>;
+//#if curved
     if (params.shape == 1u) {
         c = cylinder_trace_ray(params.eye, d, wi);
     } else {
         c = trace_ray(params.eye, d, wi);
     }
+//#else
+    c = trace_ray(params.eye, d, wi);
+//#endif
     let prev = select(vec4<f32>(0.0), accum[idx], s > 0u);
     accum[idx] = prev + vec4<f32>(c, 1.0);
 }
