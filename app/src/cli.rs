@@ -100,6 +100,32 @@ pub enum Command {
         #[arg(long)]
         out: PathBuf,
     },
+    /// What the preset needs in a scene: its feature set and why each other feature is left out,
+    /// the view shader specialised to it against the all-features shader (naga statements), the
+    /// GPU data by part, and with --time compile and frame times of both pipelines.
+    Inspect {
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+        /// Light angle from the normal, degrees (0 puts it at the normal: no shadow rays).
+        #[arg(long, default_value_t = 30.0)]
+        light_deg: f64,
+        /// Light azimuth, degrees.
+        #[arg(long, default_value_t = 90.0)]
+        light_azimuth_deg: f64,
+        /// The object: the plane, or a cylinder of radius 2.
+        #[arg(long, value_enum, default_value_t = ShapeArg::Plane)]
+        shape: ShapeArg,
+        /// Also compile and time both pipelines on the GPU adapter (view 60°, distance 6).
+        #[arg(long)]
+        time: bool,
+        /// Image size for --time, WxH.
+        #[arg(long, default_value = "256x192", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Timed batches of 8 frames per mode for --time.
+        #[arg(long, default_value_t = 5)]
+        frames: u32,
+    },
     /// Parse and validate a preset; exit code 2 and every problem on failure.
     Validate,
     /// Print the preset (the built-in default when --preset is omitted) as RON.

@@ -6,6 +6,7 @@
 mod cli;
 mod editor;
 mod eval;
+mod inspect;
 mod preset_io;
 mod render_cmd;
 mod report;
@@ -145,6 +146,41 @@ fn run(cli: Cli) -> Result<()> {
                 written.len(),
                 out.display()
             );
+        }
+        Some(Command::Inspect {
+            json,
+            light_deg,
+            light_azimuth_deg,
+            shape,
+            time,
+            size,
+            frames,
+        }) => {
+            let view = render_cmd::View {
+                view_deg: 60.0,
+                view_azimuth_deg: 0.0,
+                light_deg,
+                light_azimuth_deg,
+                distance: 6.0,
+                shape: match shape {
+                    cli::ShapeArg::Plane => lodestone_core::cylinder::Shape::Plane,
+                    cli::ShapeArg::Cylinder => {
+                        lodestone_core::cylinder::Shape::Cylinder { radius: 2.0 }
+                    }
+                },
+            };
+            let opts = inspect::Options {
+                view,
+                time,
+                size,
+                frames,
+            };
+            let i = inspect::inspect(&preset, opts)?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&i.to_json())?);
+            } else {
+                print!("{}", i.to_text());
+            }
         }
         Some(Command::Validate) => println!("ok: {} is a valid preset", material.name),
         Some(Command::Show) => println!("{}", material.to_ron()),

@@ -31,7 +31,8 @@ pub struct View {
 }
 
 impl View {
-    fn scene(&self) -> Scene {
+    /// The scene: camera on the plane's origin, light from the given angles.
+    pub fn scene(&self) -> Scene {
         let camera = Camera {
             elevation_deg: self.view_deg.clamp(0.0, Camera::MAX_ELEVATION_DEG),
             azimuth_deg: self.view_azimuth_deg,
@@ -75,7 +76,7 @@ fn save_as(img: &LinearImage, dir: &Path, name: &str, formats: Formats) -> Resul
     Ok(())
 }
 
-fn renderer() -> Result<Renderer> {
+pub fn renderer() -> Result<Renderer> {
     let ctx = GpuContext::new_headless()?;
     log::info!("adapter: {}", ctx.describe());
     Ok(Renderer::new(ctx))
@@ -161,6 +162,33 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
+/// Median frame time of `mode` in milliseconds, after one warm-up frame (which also compiles the
+/// pipeline). Throughput: batches of 8 frames submitted back to back, one wait per batch; the
+/// median over `frames` batches of the mean frame time (single-frame submit/wait latency would
+/// dominate on a fast GPU otherwise).
+pub fn frame_ms(
+    r: &Renderer,
+    target: &mut ViewTarget,
+    gm: &GpuMaterial,
+    scene: &Scene,
+    mode: ViewMode,
+    frames: u32,
+) -> f64 {
+    const BATCH: u32 = 8;
+    r.draw(target, gm, scene, mode, 1);
+    r.wait();
+    let mut times = vec![];
+    for _ in 0..frames.max(1) {
+        let t = Instant::now();
+        for _ in 0..BATCH {
+            r.draw(target, gm, scene, mode, 1);
+        }
+        r.wait();
+        times.push(t.elapsed().as_secs_f64() * 1e3 / f64::from(BATCH));
+    }
+    median(times)
+}
+
 /// `lodestone bench`.
 pub fn bench(preset: &Resolved, size: (u32, u32), frames: u32, json: bool) -> Result<()> {
     let prepared = preset.prepare()?;
@@ -183,22 +211,7 @@ pub fn bench(preset: &Resolved, size: (u32, u32), frames: u32, json: bool) -> Re
         ("filtered", ViewMode::Filtered),
         ("truth (1 ray/pixel)", ViewMode::Truth),
     ] {
-        r.draw(&mut target, &gm, &scene, mode, 1);
-        r.wait();
-        // Throughput: batches of BATCH frames submitted back to back, one wait per batch; the median
-        // over batches of the mean frame time (single-frame submit/wait latency would dominate on a
-        // fast GPU otherwise).
-        const BATCH: u32 = 8;
-        let mut times = vec![];
-        for _ in 0..frames.max(1) {
-            let t = Instant::now();
-            for _ in 0..BATCH {
-                r.draw(&mut target, &gm, &scene, mode, 1);
-            }
-            r.wait();
-            times.push(t.elapsed().as_secs_f64() * 1e3 / f64::from(BATCH));
-        }
-        rows.push((name, median(times)));
+        rows.push((name, frame_ms(&r, &mut target, &gm, &scene, mode, frames)));
     }
     let ratio = rows[2].1 / rows[0].1;
     let adapter = r.context().describe();

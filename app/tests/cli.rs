@@ -220,3 +220,55 @@ fn report_writes_tables_and_charts() {
     assert!(md.contains("| naive MIP |") && md.contains("ref. noise"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `lodestone inspect --json --time` on the flat colour-mapped noise: no relief, no shadows, a
+/// smaller shader and less data than all features, and both pipelines timed (where there is an
+/// adapter; exit code 3 otherwise).
+#[test]
+fn inspect_reports_features_shader_size_data_and_timings() {
+    let preset = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../presets/colormapped-noise.ron"
+    );
+    let out = lodestone(&[
+        "--preset", preset, "inspect", "--json", "--time", "--size", "16x12", "--frames", "1",
+    ]);
+    if out.status.code() == Some(3) {
+        eprintln!("skipping the timings: no adapter");
+        return;
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}\n{text}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+    let features: Vec<&str> = v["features"]
+        .as_array()
+        .expect("features")
+        .iter()
+        .map(|f| f.as_str().expect("name"))
+        .collect();
+    assert_eq!(features, ["noise", "driver_color"]);
+    let left_out = v["left_out"].as_array().expect("left out");
+    assert!(
+        left_out
+            .iter()
+            .any(|l| l["feature"] == "relief" && l["why"].as_str().unwrap().contains("flat"))
+    );
+    let stmts = |k: &str| v["shader"][k]["statements"].as_u64().expect("statements");
+    assert!(stmts("specialised") * 3 < stmts("all_features"));
+    let bytes = |k: &str| v["data"][k].as_u64().expect("bytes");
+    assert!(bytes("specialised_bytes") < bytes("all_features_bytes"));
+    let frames = v["timings"]["frame_ms"].as_array().expect("timings");
+    assert_eq!(frames.len(), 4);
+    for f in frames {
+        for k in ["specialised", "all_features"] {
+            assert!(
+                f[k].as_f64().is_some_and(|t| t > 0.0 && t.is_finite()),
+                "{f}"
+            );
+        }
+    }
+}

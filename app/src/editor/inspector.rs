@@ -6,6 +6,7 @@ use super::gradient_editor::GradientEditor;
 use egui::{Slider, Ui};
 use lodestone_core::colormap::Gradient;
 use lodestone_core::effective_height::HeightFilter;
+use lodestone_core::features::{Feature, FeatureSet};
 use lodestone_core::material::{ColorModel, ColorSource, Driver, Filtering, Material};
 use lodestone_core::noise::NoiseParams;
 use lodestone_core::shadowing::Correlation;
@@ -21,6 +22,33 @@ pub struct Inspector {
     pub isotropic_lock: bool,
     /// Skewness and excess kurtosis of the loaded image driver, if any (set by the editor).
     pub driver_shape: Option<(f64, f64)>,
+    /// The material's features at the last frame: a section collapses when the feature it
+    /// edits goes unused (and opens again when it comes back).
+    last_features: Option<FeatureSet>,
+}
+
+/// A section header that collapses when `used` turns false and opens when it turns true again,
+/// or on the first frame of an inspector (otherwise it keeps whatever the user chose); its title
+/// says why it does nothing.
+fn section(
+    title: &str,
+    used: bool,
+    unused_why: &str,
+    was_used: Option<bool>,
+) -> egui::CollapsingHeader {
+    let text = if used {
+        title.to_string()
+    } else {
+        format!("{title} (unused: {unused_why})")
+    };
+    let h = egui::CollapsingHeader::new(text)
+        .id_salt(title)
+        .default_open(used);
+    // A new inspector (a material just loaded) starts from what the material uses.
+    match was_used {
+        Some(before) if before == used => h,
+        _ => h.open(Some(used)),
+    }
 }
 
 fn slider_f64(
@@ -53,6 +81,10 @@ impl Inspector {
     /// Show every control; returns true when the material changed.
     pub fn ui(&mut self, ui: &mut Ui, m: &mut Material) -> bool {
         let mut changed = false;
+        let features = FeatureSet::of_material(m);
+        let last = self.last_features.replace(features);
+        let relief = features.contains(Feature::Relief);
+        let had_relief = last.map(|f| f.contains(Feature::Relief));
         ui.horizontal(|ui| {
             let l = ui.label("Name");
             changed |= ui
@@ -78,8 +110,7 @@ impl Inspector {
                 ui.label("Height transfer function g [HNPN14 Sec. 7]");
                 changed |= self.curve.ui(ui, &mut m.heights.transfer);
             });
-        egui::CollapsingHeader::new("Slopes")
-            .default_open(true)
+        section("Slopes", relief, "the surface is flat, sigma_h = 0", had_relief)
             .show(ui, |ui| {
                 let from_image = matches!(m.driver, Driver::Image { .. });
                 if from_image {
@@ -125,8 +156,10 @@ impl Inspector {
                     "Lambertian albedo multiplying the colour map, ρ_d·C/π", false);
                 changed |= slider_f64(ui, &mut b.specular, 0.0..=1.0, "Specular",
                     "Specular reflectance of the slope-space Beckmann lobe", false);
+                ui.add_enabled_ui(b.specular > 0.0, |ui| {
                 changed |= slider_f64(ui, &mut b.roughness, 0.001..=1.0, "Roughness σ_n0",
-                    "σ_n0: base roughness (slope std of the BRDF lobe); filtered adds the footprint's slope variance, σ_n0² + σ_n² [HN12 Sec. 5.5]", true);
+                    "σ_n0: base roughness (slope std of the BRDF lobe); filtered adds the footprint's slope variance, σ_n0² + σ_n² [HN12 Sec. 5.5]. Unused while Specular is 0", true);
+                });
             });
         egui::CollapsingHeader::new("Filtering")
             .default_open(false)

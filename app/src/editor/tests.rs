@@ -413,3 +413,26 @@ fn image_driver_histogram_shape_is_shown() {
     );
     h.get_by_label_contains("Histogram: skewness -0.27");
 }
+
+#[test]
+fn sections_that_do_nothing_collapse_and_come_back() {
+    let mut h = harness(1600.0, 900.0, DeviceSource::Unavailable);
+    h.step();
+    let ctx = h.ctx.clone();
+    h.state_mut()
+        .open_path(&ctx, &preset("colormapped-noise.ron"));
+    h.step();
+    h.step();
+    assert_eq!(h.state().material().heights.sigma_h, 0.0);
+    // Flat: the slope section says why it does nothing and its sliders are hidden.
+    h.get_by_label_contains("Slopes (unused: the surface is flat");
+    assert!(h.query_by_label("σ_nx").is_none());
+    // Relief back: the section opens again.
+    h.get_by_role_and_label(egui::accesskit::Role::Slider, "σ_h")
+        .set_value_accesskit(0.05);
+    h.step();
+    h.step();
+    h.step();
+    assert!(h.query_by_label_contains("Slopes (unused").is_none());
+    h.get_by_role_and_label(egui::accesskit::Role::Slider, "σ_nx");
+}

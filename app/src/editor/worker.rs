@@ -314,6 +314,17 @@ impl State {
         if !self.upload(&req.material, &req.image, send) {
             return Ok(None);
         }
+        if let Some((_, gm)) = &self.material {
+            // The pipeline this scene needs is compiled at its first draw; the variant for the
+            // light on the other side of the normal (shadow rays or none) is compiled ahead on
+            // another thread, so dragging the light through the zenith does not wait for one.
+            let f = gm.features();
+            let shape = req.scene.shape;
+            self.renderer.prewarm(vec![
+                f.in_scene(shape, glam::DVec3::Z).normalized(),
+                f.in_scene(shape, glam::DVec3::X).normalized(),
+            ]);
+        }
         let max_scale = req.max_scale.clamp(MIN_SCALE, 1.0);
         let mut scale = self.first_scale(req);
         loop {
