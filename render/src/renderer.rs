@@ -435,9 +435,13 @@ pub fn material_data_for(
         base.tt_m_max = t.m_max as f32;
         base.tt_sigma_max = t.sigma_max as f32;
     }
-    let dh = EffectiveHeightTable::shared();
     let points = m.filtering.slope_points.max(1) as usize;
     if features.contains(Feature::Relief) {
+        // Built on first use (process-wide): a session of flat materials never builds it.
+        let dh = EffectiveHeightTable::shared();
+        base.dh_size = dh.mean.len() as u32;
+        base.dh_ln_min = dh.ln_l_min as f32;
+        base.dh_ln_max = dh.ln_l_max as f32;
         let start = data.len();
         lay.dh = data.len() as u32;
         for (a, b) in dh.mean.iter().zip(&dh.std) {
@@ -485,9 +489,6 @@ pub fn material_data_for(
     base.ct_offset = lay.color_table;
     base.tt_offset = lay.transfer_table;
     base.dh_offset = lay.dh;
-    base.dh_size = dh.mean.len() as u32;
-    base.dh_ln_min = dh.ln_l_min as f32;
-    base.dh_ln_max = dh.ln_l_max as f32;
     base.gh_offset = lay.gh;
     base.slope_points = points as u32;
     base.cp_offset = lay.color_poly;
