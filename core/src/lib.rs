@@ -33,3 +33,4 @@ pub mod stability;
 pub mod surface;
 pub mod transfer;
 pub mod validation;
+pub mod visible_slopes;
