@@ -3,6 +3,7 @@
 //! Exit codes: 0 success, 1 other failure, 2 bad input (unreadable or invalid preset),
 //! 3 no GPU adapter.
 
+mod chart;
 mod cli;
 mod editor;
 mod eval;

@@ -13,8 +13,9 @@
 //! * Times are synchronised wall times (submit, then wait for the device), medians of `repeats` runs;
 //!   timestamp queries are not used. On the software adapter they are CPU times.
 
+use crate::chart::{Chart, Series};
 use crate::preset_io::Resolved;
-use anyhow::Result;
+use anyhow::{Context, Result};
 use glam::DVec3;
 use lodestone_core::camera::Camera;
 use lodestone_core::cielab::delta_e76;
@@ -392,130 +393,13 @@ pub fn markdown(rep: &Report) -> String {
 }
 
 /// One chart series: label, colour, points, joined by a line.
-type Series<'a> = (String, &'a str, Vec<(f64, f64)>, bool);
-
 const COLORS: [&str; 5] = ["#d62728", "#1f77b4", "#ff7f0e", "#2ca02c", "#555555"];
-
-/// A minimal SVG line/point chart: `series` of (label, colour, points); log axes when asked.
-fn svg_chart(
-    title: &str,
-    x_label: &str,
-    y_label: &str,
-    series: &[Series],
-    log_x: bool,
-    log_y: bool,
-) -> String {
-    let (w, h, ml, mr, mt, mb) = (720.0, 440.0, 70.0, 230.0, 40.0, 50.0);
-    let tx = |v: f64| if log_x { v.max(1e-12).log10() } else { v };
-    let ty = |v: f64| if log_y { v.max(1e-12).log10() } else { v };
-    let pts: Vec<(f64, f64)> = series
-        .iter()
-        .flat_map(|s| s.2.iter().map(|p| (tx(p.0), ty(p.1))))
-        .collect();
-    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for (x, y) in &pts {
-        x0 = x0.min(*x);
-        x1 = x1.max(*x);
-        y0 = y0.min(*y);
-        y1 = y1.max(*y);
-    }
-    if !(x1 > x0) {
-        x1 = x0 + 1.0;
-    }
-    if !(y1 > y0) {
-        y1 = y0 + 1.0;
-    }
-    let px = |x: f64| ml + (tx(x) - x0) / (x1 - x0) * (w - ml - mr);
-    let py = |y: f64| h - mb - (ty(y) - y0) / (y1 - y0) * (h - mt - mb);
-    let mut s = format!(
-        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n\
-         <rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n<text x=\"{ml}\" y=\"22\" font-size=\"15\">{title}</text>\n\
-         <line x1=\"{ml}\" y1=\"{}\" x2=\"{}\" y2=\"{}\" stroke=\"black\"/>\n<line x1=\"{ml}\" y1=\"{mt}\" x2=\"{ml}\" y2=\"{}\" stroke=\"black\"/>\n",
-        h - mb,
-        w - mr,
-        h - mb,
-        h - mb
-    );
-    let fmt = |v: f64, log: bool| {
-        let x = if log { 10f64.powf(v) } else { v };
-        if x != 0.0 && (x.abs() < 0.01 || x.abs() >= 1e4) {
-            format!("{x:.2e}")
-        } else {
-            format!("{x:.3}")
-        }
-    };
-    for i in 0..=4 {
-        let fx = x0 + (x1 - x0) * f64::from(i) / 4.0;
-        let fy = y0 + (y1 - y0) * f64::from(i) / 4.0;
-        let gx = ml + (w - ml - mr) * f64::from(i) / 4.0;
-        let gy = h - mb - (h - mt - mb) * f64::from(i) / 4.0;
-        let _ = writeln!(
-            s,
-            "<text x=\"{gx}\" y=\"{}\" text-anchor=\"middle\">{}</text>",
-            h - mb + 16.0,
-            fmt(fx, log_x)
-        );
-        let _ = writeln!(
-            s,
-            "<text x=\"{}\" y=\"{}\" text-anchor=\"end\">{}</text>",
-            ml - 6.0,
-            gy + 4.0,
-            fmt(fy, log_y)
-        );
-        let _ = writeln!(
-            s,
-            "<line x1=\"{ml}\" y1=\"{gy}\" x2=\"{}\" y2=\"{gy}\" stroke=\"#ddd\"/>",
-            w - mr
-        );
-    }
-    let _ = writeln!(
-        s,
-        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{x_label}</text>",
-        (ml + w - mr) / 2.0,
-        h - 12.0
-    );
-    let _ = writeln!(
-        s,
-        "<text x=\"16\" y=\"{}\" transform=\"rotate(-90 16 {})\" text-anchor=\"middle\">{y_label}</text>",
-        (mt + h - mb) / 2.0,
-        (mt + h - mb) / 2.0
-    );
-    for (i, (label, color, points, line)) in series.iter().enumerate() {
-        if *line && points.len() > 1 {
-            let path: Vec<String> = points
-                .iter()
-                .map(|(x, y)| format!("{:.1},{:.1}", px(*x), py(*y)))
-                .collect();
-            let _ = writeln!(
-                s,
-                "<polyline fill=\"none\" stroke=\"{color}\" stroke-width=\"2\" points=\"{}\"/>",
-                path.join(" ")
-            );
-        }
-        for (x, y) in points {
-            let _ = writeln!(
-                s,
-                "<circle cx=\"{:.1}\" cy=\"{:.1}\" r=\"4\" fill=\"{color}\"/>",
-                px(*x),
-                py(*y)
-            );
-        }
-        let ly = mt + 18.0 * i as f64;
-        let _ = writeln!(
-            s,
-            "<circle cx=\"{}\" cy=\"{ly}\" r=\"5\" fill=\"{color}\"/><text x=\"{}\" y=\"{}\">{label}</text>",
-            w - mr + 16.0,
-            w - mr + 26.0,
-            ly + 4.0
-        );
-    }
-    s + "</svg>\n"
-}
 
 /// Error (mean ΔE*ab: robust, unlike RMSE, to the few firefly pixels near the horizon) against time
 /// (log–log; one point per method averaged over the configurations, a curve for ground truth over
-/// rays per pixel) and against view angle per method (light at the normal, middle zoom), as SVG.
-pub fn charts(rep: &Report) -> (String, String) {
+/// rays per pixel) and against view angle per method (light at the normal, middle zoom): file stem,
+/// chart and its series.
+pub fn charts(rep: &Report) -> Vec<(&'static str, Chart, Vec<Series>)> {
     let names: Vec<String> = rep
         .configs
         .first()
@@ -541,14 +425,14 @@ pub fn charts(rep: &Report) -> (String, String) {
         truth_curve,
         true,
     ));
-    let time_chart = svg_chart(
-        &format!("{}: error against time", rep.preset),
-        "ms per frame (log)",
-        "mean ΔE*ab vs reference (log)",
-        &series,
-        true,
-        true,
-    );
+    let time_chart = Chart {
+        title: format!("{}: error against time", rep.preset),
+        x_label: "ms per frame (log)".into(),
+        y_label: "mean ΔE*ab vs reference (log)".into(),
+        log_x: true,
+        log_y: true,
+    };
+    let time_series = series;
     let mut zooms: Vec<f64> = rep.configs.iter().map(|c| c.distance).collect();
     zooms.dedup();
     let mid = zooms.get(zooms.len() / 2).copied().unwrap_or(0.0);
@@ -565,27 +449,35 @@ pub fn charts(rep: &Report) -> (String, String) {
             .collect();
         series.push((name.clone(), COLORS[series.len() % 5], pts, true));
     }
-    let view_chart = svg_chart(
-        &format!(
+    let view_chart = Chart {
+        title: format!(
             "{}: error against view angle (distance {mid}, light at the normal)",
             rep.preset
         ),
-        "view angle from the normal (degrees)",
-        "mean ΔE*ab vs reference (log)",
-        &series,
-        false,
-        true,
-    );
-    (time_chart, view_chart)
+        x_label: "view angle from the normal (degrees)".into(),
+        y_label: "mean ΔE*ab vs reference (log)".into(),
+        log_x: false,
+        log_y: true,
+    };
+    vec![
+        ("error_vs_time", time_chart, time_series),
+        ("error_vs_view", view_chart, series),
+    ]
 }
 
-/// Write report.json, report.md, error_vs_time.svg and error_vs_view.svg into `dir`.
+/// Write report.json, report.md and the charts error_vs_time and error_vs_view, each as PNG and
+/// SVG, into `dir`.
 pub fn write(rep: &Report, dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir)?;
     std::fs::write(dir.join("report.json"), serde_json::to_string_pretty(rep)?)?;
     std::fs::write(dir.join("report.md"), markdown(rep))?;
-    let (t, v) = charts(rep);
-    std::fs::write(dir.join("error_vs_time.svg"), t)?;
-    std::fs::write(dir.join("error_vs_view.svg"), v)?;
+    for (stem, chart, series) in charts(rep) {
+        std::fs::write(dir.join(format!("{stem}.svg")), chart.svg(&series))?;
+        let png = dir.join(format!("{stem}.png"));
+        chart
+            .png(&series)
+            .save(&png)
+            .with_context(|| format!("writing {}", png.display()))?;
+    }
     Ok(())
 }

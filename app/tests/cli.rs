@@ -189,6 +189,8 @@ fn report_writes_tables_and_charts() {
         "report.json",
         "report.md",
         "error_vs_time.svg",
+        "error_vs_time.png",
+        "error_vs_view.png",
         "error_vs_view.svg",
     ] {
         assert!(dir.join(f).is_file(), "{f} missing");
