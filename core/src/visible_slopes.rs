@@ -85,11 +85,22 @@ fn mills_tail(x: f64, depth: u32) -> f64 {
 /// converged to 1e-13 at x = 1, see the tests). Above, `R = √(π/2)·erfcx(−r/√2)` directly.
 fn kappas(r: f64) -> (f64, f64) {
     if r <= -1.0 {
-        let x = (-r).min(1e150);
-        let g1 = mills_tail(x, 400);
-        return (g1, x * g1 + 1.0);
+        kappas_continued_fraction(-r)
+    } else {
+        kappas_erfcx(r)
     }
-    // R saturates at f64::MAX for r > 37.6 (φ underflows): then κ₁ = 1/r and κ₂ = 0, as written.
+}
+
+/// κ's from the continued fraction, x = −r > 0.
+fn kappas_continued_fraction(x: f64) -> (f64, f64) {
+    let x = x.min(1e150);
+    let g1 = mills_tail(x, 400);
+    (g1, x * g1 + 1.0)
+}
+
+/// κ's from `R = √(π/2)·erfcx(−r/√2)`. R saturates at f64::MAX for r > 37.6 (φ underflows):
+/// then κ₁ = 1/r and κ₂ = 0, as written.
+fn kappas_erfcx(r: f64) -> (f64, f64) {
     let mills = (std::f64::consts::PI / 2.0).sqrt() * erfcx(-r / std::f64::consts::SQRT_2);
     (1.0 / (r + 1.0 / mills), 1.0 / (r * mills + 1.0))
 }
@@ -240,14 +251,16 @@ mod tests {
 
     #[test]
     fn the_mills_ratio_branches_agree_and_the_grazing_limit_is_the_silhouette() {
-        // The continued fraction (r ≤ −3) against the erfcx form at the switch, and converged.
-        // (core's erfcx is good to about 1e-8 relative there; rR + 1 = 0.34 amplifies it 3×.)
-        let (a1, a2) = kappas(-0.999_999_9);
-        let (b1, b2) = kappas(-1.0);
-        assert!(
-            (a1 / b1 - 1.0).abs() < 1e-7 && (a2 / b2 - 1.0).abs() < 1e-7,
-            "{a1} {b1} {a2} {b2}"
-        );
+        // The two forms agree where both are accurate (rR + 1 cancels little at r ≥ −3), and the
+        // continued fraction has converged.
+        for r in [-1.0, -2.0, -3.0] {
+            let (a1, a2) = kappas_erfcx(r);
+            let (b1, b2) = kappas_continued_fraction(-r);
+            assert!(
+                (a1 / b1 - 1.0).abs() < 1e-12 && (a2 / b2 - 1.0).abs() < 1e-12,
+                "r = {r}: {a1} {b1} {a2} {b2}"
+            );
+        }
         // Against Φ̄/φ from libm's erfc (Python: 0.5·erfc(3/√2)/φ(3)) at x = 3.
         assert!((kappas(-3.0).0 / 3.532_337_517_625_192 - 1.0).abs() < 1e-13);
         for x in [1.0, 3.0, 5.0, 30.0, 1e4] {
