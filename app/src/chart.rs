@@ -214,9 +214,18 @@ pub struct PngCanvas {
     font: ab_glyph::FontRef<'static>,
 }
 
-fn parse_color(hex: &str) -> tiny_skia::Color {
+/// An anti-aliased solid paint of `#rrggbb`.
+fn paint(hex: &str) -> tiny_skia::Paint<'static> {
     let v = u32::from_str_radix(hex.trim_start_matches('#'), 16).unwrap_or(0);
-    tiny_skia::Color::from_rgba8((v >> 16) as u8, (v >> 8) as u8, v as u8, 255)
+    let mut paint = tiny_skia::Paint::default();
+    paint.set_color(tiny_skia::Color::from_rgba8(
+        (v >> 16) as u8,
+        (v >> 8) as u8,
+        v as u8,
+        255,
+    ));
+    paint.anti_alias = true;
+    paint
 }
 
 impl PngCanvas {
@@ -239,9 +248,7 @@ impl PngCanvas {
 
     fn stroke(&mut self, path: Option<tiny_skia::Path>, color: &str, width: f64) {
         let Some(path) = path else { return };
-        let mut paint = tiny_skia::Paint::default();
-        paint.set_color(parse_color(color));
-        paint.anti_alias = true;
+        let paint = paint(color);
         let stroke = tiny_skia::Stroke {
             width: width as f32,
             ..tiny_skia::Stroke::default()
@@ -279,9 +286,7 @@ impl Canvas for PngCanvas {
         else {
             return;
         };
-        let mut paint = tiny_skia::Paint::default();
-        paint.set_color(parse_color(color));
-        paint.anti_alias = true;
+        let paint = paint(color);
         self.pixmap.fill_path(
             &path,
             &paint,

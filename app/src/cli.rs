@@ -191,6 +191,19 @@ pub enum ShapeArg {
     Cylinder,
 }
 
+impl ShapeArg {
+    /// The object, with `radius` for the cylinder (which must be positive and finite).
+    pub fn shape(self, radius: f64) -> Result<lodestone_core::cylinder::Shape, String> {
+        match self {
+            ShapeArg::Plane => Ok(lodestone_core::cylinder::Shape::Plane),
+            ShapeArg::Cylinder if radius > 0.0 && radius.is_finite() => {
+                Ok(lodestone_core::cylinder::Shape::Cylinder { radius })
+            }
+            ShapeArg::Cylinder => Err(format!("--radius must be a positive number, got {radius}")),
+        }
+    }
+}
+
 /// Parse "WxH".
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s

@@ -118,15 +118,7 @@ fn run(cli: Cli) -> Result<()> {
             out,
             formats,
         }) => {
-            let shape = match shape {
-                cli::ShapeArg::Plane => lodestone_core::cylinder::Shape::Plane,
-                cli::ShapeArg::Cylinder => {
-                    if !(radius > 0.0 && radius.is_finite()) {
-                        anyhow::bail!("--radius must be a positive number, got {radius}");
-                    }
-                    lodestone_core::cylinder::Shape::Cylinder { radius }
-                }
-            };
+            let shape = shape.shape(radius).map_err(anyhow::Error::msg)?;
             let view = render_cmd::View {
                 view_deg,
                 view_azimuth_deg,
@@ -163,12 +155,7 @@ fn run(cli: Cli) -> Result<()> {
                 light_deg,
                 light_azimuth_deg,
                 distance: 6.0,
-                shape: match shape {
-                    cli::ShapeArg::Plane => lodestone_core::cylinder::Shape::Plane,
-                    cli::ShapeArg::Cylinder => {
-                        lodestone_core::cylinder::Shape::Cylinder { radius: 2.0 }
-                    }
-                },
+                shape: shape.shape(2.0).map_err(anyhow::Error::msg)?,
             };
             let opts = inspect::Options {
                 view,

@@ -536,7 +536,7 @@ fn lit(cfg: &Config, n: DVec3) -> f64 {
 }
 
 /// Lower-triangular Cholesky factor (l11, l21, l22) of [[xx, xy], [xy, yy]]; semi-definite safe.
-fn cholesky(xx: f64, xy: f64, yy: f64) -> (f64, f64, f64) {
+pub(crate) fn cholesky(xx: f64, xy: f64, yy: f64) -> (f64, f64, f64) {
     let l11 = xx.max(0.0).sqrt();
     let l21 = if l11 > 0.0 { xy / l11 } else { 0.0 };
     (l11, l21, (yy - l21 * l21).max(0.0).sqrt())
@@ -579,7 +579,7 @@ pub fn visible_slope_mean(
 
 /// `E[u⁺]` for `u = a − s·b` with `s ~ N(mean, Σ)`: `mΦ(m/√v) + √v φ(m/√v)`, `m = a − mean·b`,
 /// `v = bᵀΣb` (`m⁺` when v = 0).
-fn expected_positive_part(a: f64, b: DVec2, mean: DVec2, sigma: &SlopeCov) -> f64 {
+pub(crate) fn expected_positive_part(a: f64, b: DVec2, mean: DVec2, sigma: &SlopeCov) -> f64 {
     let m = a - mean.dot(b);
     let v = b.x * b.x * sigma.xx + 2.0 * b.x * b.y * sigma.xy + b.y * b.y * sigma.yy;
     if v > 1e-300 {

@@ -51,9 +51,9 @@
 //! only C¹ (n = 1 is the colour at the mean slope). A steepness-indexed map could instead be
 //! pre-convolved like the colour table; that and the GPU mirror are the next steps.
 
-use crate::footprint::hermite_rule;
+use crate::footprint::{cholesky, expected_positive_part, hermite_rule};
 use crate::slopes::SlopeCov;
-use crate::special::{erfcx, norm_cdf, norm_pdf};
+use crate::special::erfcx;
 use glam::{DVec2, DVec3};
 
 /// The Gaussian approximation of D_s(ω_o): its exact mean and covariance, and Z (the footprint's
@@ -133,11 +133,7 @@ impl VisibleSlopes {
             yy: (sigma.yy - sb.y * sb.y * shrink).max(0.0),
             xy: sigma.xy - sb.x * sb.y * shrink,
         };
-        let projected_area = if r > -38.0 {
-            (m * norm_cdf(r) + sv * norm_pdf(r)).max(0.0)
-        } else {
-            0.0
-        };
+        let projected_area = expected_positive_part(a, b, mean, sigma).max(0.0);
         Self {
             mean: mean - sb * (k1 / sv),
             cov,
@@ -149,9 +145,7 @@ impl VisibleSlopes {
     /// `f(mean)`). Error against n and against the exact D_s: see the module docs.
     pub fn average(&self, n: usize, f: impl Fn(DVec2) -> DVec3) -> DVec3 {
         let (x, w) = hermite_rule(n);
-        let l11 = self.cov.xx.max(0.0).sqrt();
-        let l21 = if l11 > 0.0 { self.cov.xy / l11 } else { 0.0 };
-        let l22 = (self.cov.yy - l21 * l21).max(0.0).sqrt();
+        let (l11, l21, l22) = cholesky(self.cov.xx, self.cov.xy, self.cov.yy);
         let mut sum = DVec3::ZERO;
         for (xa, wa) in x.iter().zip(w) {
             for (xb, wb) in x.iter().zip(w) {
