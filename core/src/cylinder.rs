@@ -15,7 +15,7 @@ use crate::brdf::normal_of;
 use crate::camera::{Camera, PIXEL_SIGMA};
 use crate::footprint::{Method, Prepared};
 use crate::surface::sphere_trace;
-use glam::{DMat2, DVec2, DVec3};
+use glam::{DMat2, DMat3, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
 /// Which object the views show.
@@ -131,16 +131,12 @@ impl Prepared {
         let fr = frame(phi);
         let n = normal_of(DVec2::new(grad.x, grad.y * r / rho.max(1e-300)));
         let (wo_l, wi_l) = (local(-dir, fr), local(wi, fr));
-        if n.dot(wi_l) <= 0.0 {
-            return [0.0; 3];
-        }
         // Shadow ray: to where it leaves the bounding cylinder.
-        if let Some((_, e1)) = intersect(r, outer, p, wi)
-            && self.cylinder_march(r, p, wi, e1).is_some()
-        {
-            return [0.0; 3];
-        }
-        self.material.brdf.shade(self.color_at(f), n, wo_l, wi_l)
+        let sees = || {
+            intersect(r, outer, p, wi).is_none_or(|(_, e1)| self.cylinder_march(r, p, wi, e1).is_none())
+        };
+        let m = DMat3::from_cols(fr.0, fr.1, fr.2);
+        self.shade_hit(f, n, wo_l, wi_l, &m, sees)
     }
 
     /// One pixel of an analytic view of the cylinder: the ray meets the mean cylinder; the plane
@@ -168,7 +164,8 @@ impl Prepared {
         let o = to_tangent(ray.origin, hit, uv, fr);
         let d = local(ray.dir, fr);
         let fp = crate::noise::Footprint { cov };
-        self.pixel(method, o, d, local(wi, fr), fp)
+        let m = DMat3::from_cols(fr.0, fr.1, fr.2);
+        self.pixel_in_frame(method, o, d, local(wi, fr), fp, &m)
     }
 }
 

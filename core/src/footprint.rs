@@ -23,6 +23,10 @@
 
 use crate::attribute::{attribute_shape, mean_attribute_shape};
 use crate::brdf::{gaussian2, normal_of, slope_of};
+use crate::color_terms::Affine;
+use crate::environment::EquirectMap;
+use crate::sh::Sh9;
+use crate::slope_color::CompiledSlopeColor;
 use crate::driver_field::DriverField;
 use crate::effective_height::height_moments;
 use crate::image_driver::ImageDriver;
@@ -35,7 +39,7 @@ use crate::slopes::SlopeCov;
 use crate::special::{erf, norm_cdf, norm_pdf};
 use crate::surface::{Surface, Trace, march_heightfield};
 use crate::transfer::{SurfaceStats, TransferFunction, TransferMoments, transformed_statistics};
-use glam::{DVec2, DVec3};
+use glam::{DMat3, DVec2, DVec3};
 use rayon::prelude::*;
 use std::f64::consts::FRAC_1_PI;
 use std::sync::Arc;
@@ -85,6 +89,22 @@ pub struct Prepared {
     pub transfer_table: Option<PreconvolvedTable>,
     /// Global mean and std of g(f), f ~ N(0, 1): standardizes heights for height-indexed colour.
     pub g_global: (f64, f64),
+    /// The slope colour term's map, compiled (when the material has one).
+    pub slope_color: Option<CompiledSlopeColor>,
+    /// The environment's SH9 radiance with its intensity applied: built for the procedural sky,
+    /// set by the application for a file ([`Prepared::set_environment_map`]); `None` = no
+    /// environment light (or a file not loaded yet).
+    pub environment: Option<Sh9>,
+}
+
+/// Shading inputs of a facet, or their average over a slope distribution: `E[(n·ωi)⁺]`,
+/// `E[C_s(n)(n·ωi)⁺]`, `E[E_env(n)]` and `E[C_s(n) ⊙ E_env(n)]`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct SlopeShading {
+    cos: f64,
+    cs_cos: [f64; 3],
+    env: [f64; 3],
+    cs_env: [f64; 3],
 }
 
 /// Footprint-local statistics shared by the statistical methods.
@@ -149,12 +169,118 @@ impl Prepared {
             _ => material.heights.transfer.preconvolve(spec),
         };
         let g = material.heights.transfer.moments(0.0, 1.0);
+        let environment = match previous {
+            Some(p) if p.material.lighting == material.lighting => p.environment,
+            _ => material.lighting.builtin_sh(),
+        };
         Ok(Self {
             material: material.clone(),
             surface,
             color_table,
             transfer_table,
             g_global: (g.mean, g.std.max(1e-12)),
+            slope_color: material
+                .terms
+                .slope
+                .as_ref()
+                .map(|t| t.color.compiled()),
+            environment,
+        })
+    }
+
+    /// Use an equirectangular map (loaded by the application for an environment file) as the
+    /// environment, with the material's intensity.
+    pub fn set_environment_map(&mut self, map: &EquirectMap) {
+        let intensity = self
+            .material
+            .lighting
+            .environment
+            .as_ref()
+            .map_or(0.0, |e| e.intensity);
+        self.environment = Some(map.sh().scaled(intensity));
+    }
+
+    /// `C_s(n)` of the slope term (0 without one).
+    fn slope_color_at(&self, n: DVec3) -> [f64; 3] {
+        self.slope_color.as_ref().map_or([0.0; 3], |c| c.sample(n))
+    }
+
+    /// Environment irradiance at unit normal n (0 without an environment).
+    fn environment_at(&self, n: DVec3) -> [f64; 3] {
+        self.environment.as_ref().map_or([0.0; 3], |e| e.irradiance(n))
+    }
+
+    /// [`SlopeShading`] of one facet of unit normal n (in the local tangent frame, where ωi is;
+    /// `frame` takes it to the world, where the slope colour's direction and the environment are).
+    fn point_shading(&self, n: DVec3, wi: DVec3, frame: &DMat3) -> SlopeShading {
+        let cos = n.dot(wi).max(0.0);
+        let nw = *frame * n;
+        let cs = self.slope_color_at(nw);
+        let env = self.environment_at(nw);
+        SlopeShading {
+            cos,
+            cs_cos: cs.map(|v| v * cos),
+            env,
+            cs_env: [0, 1, 2].map(|c| cs[c] * env[c]),
+        }
+    }
+
+    /// [`SlopeShading`] averaged over the visible slope distribution D_s(ωo) of slopes N(mean, Σ)
+    /// (world slope space) on the material's weighted Gauss–Hermite nodes ([`visible_slope_nodes`]):
+    /// C_s and the environment are averaged *jointly* with the clamped cosine, so no independence of
+    /// colour and shading is assumed ([HNPN14 Sec. 5.2] assumes it; the joint average costs the same).
+    fn visible_shading(
+        &self,
+        mean: DVec2,
+        sigma: &SlopeCov,
+        wo: DVec3,
+        wi: DVec3,
+        frame: &DMat3,
+    ) -> SlopeShading {
+        let mut acc = SlopeShading::default();
+        let points = self.material.filtering.slope_points as usize;
+        let den = visible_slope_nodes(mean, sigma, wo, points, |n, w| {
+            let p = self.point_shading(n, wi, frame);
+            acc.cos += w * p.cos;
+            for c in 0..3 {
+                acc.cs_cos[c] += w * p.cs_cos[c];
+                acc.env[c] += w * p.env[c];
+                acc.cs_env[c] += w * p.cs_env[c];
+            }
+        });
+        if den > 0.0 {
+            let inv = 1.0 / den;
+            acc.cos *= inv;
+            for c in 0..3 {
+                acc.cs_cos[c] *= inv;
+                acc.env[c] *= inv;
+                acc.cs_env[c] *= inv;
+            }
+            acc
+        } else {
+            SlopeShading::default()
+        }
+    }
+
+    /// Radiance from the combined colour `A + K ⊙ C_s` (`sun_color` under the directional light,
+    /// `env_color` under the environment, which can differ because D_h differs), the shading inputs,
+    /// the directional light's visibility `v` (shadowing) and the uncoloured specular:
+    /// `ρ_d/π·(sun·v·(A⊙E[cos] + K⊙E[C_s cos]) + A⊙E[E_env] + K⊙E[C_s⊙E_env]) + sun·v·spec`.
+    fn radiance(
+        &self,
+        sun_color: Affine,
+        env_color: Affine,
+        s: &SlopeShading,
+        v: f64,
+        spec: f64,
+    ) -> [f64; 3] {
+        let sun = self.material.lighting.sun * v;
+        let kd = self.material.brdf.albedo * FRAC_1_PI;
+        [0, 1, 2].map(|c| {
+            kd * (sun * (sun_color.a[c] * s.cos + sun_color.k[c] * s.cs_cos[c])
+                + env_color.a[c] * s.env[c]
+                + env_color.k[c] * s.cs_env[c])
+                + sun * spec
         })
     }
 
@@ -259,30 +385,62 @@ impl Prepared {
         }
     }
 
-    /// Naive MIP: `C(f̄)` shaded at the filtered normal with the base roughness; no masking.
+    /// Naive MIP: `C(f̄)` shaded at the filtered normal with the base roughness; no masking. The
+    /// slope colour and the environment irradiance are taken at the filtered normal too.
     pub fn naive(&self, cfg: &Config) -> [f64; 3] {
-        let loc = self.local(cfg);
-        let n = normal_of(loc.stats.slope_mean);
-        self.material
-            .brdf
-            .shade(self.color_at(loc.driver.mean), n, cfg.wo, cfg.wi)
-            .map(|v| v * lit(cfg, n))
+        self.naive_lit(cfg, 1.0, &DMat3::IDENTITY)
     }
 
-    /// View-independent texture filtering: the exact footprint mean colour, shaded like naive.
+    fn naive_lit(&self, cfg: &Config, sun_visible: f64, frame: &DMat3) -> [f64; 3] {
+        let loc = self.local(cfg);
+        let n = normal_of(loc.stats.slope_mean);
+        let aff = self.material.terms.affine(self.color_at(loc.driver.mean));
+        let spec = self
+            .material
+            .brdf
+            .specular_with(n, cfg.wo, cfg.wi, SlopeCov::default());
+        let v = sun_visible * lit(cfg, n);
+        self.radiance(aff, aff, &self.point_shading(n, cfg.wi, frame), v, spec)
+    }
+
+    /// View-independent texture filtering: the exact footprint mean colour, shaded like naive. A
+    /// slope colour is averaged over the footprint's slopes without the projected-area weight (what
+    /// a mip-mapped slope-colour texture holds).
     pub fn view_independent(&self, cfg: &Config) -> [f64; 3] {
+        self.view_independent_lit(cfg, 1.0, &DMat3::IDENTITY)
+    }
+
+    fn view_independent_lit(&self, cfg: &Config, sun_visible: f64, frame: &DMat3) -> [f64; 3] {
         let loc = self.local(cfg);
         let (m, s) = self.input_distribution(&loc);
         let c = self.color_of_distribution(m, s, 0.0, (0.0, 1.0), s * s);
         let n = normal_of(loc.stats.slope_mean);
-        self.material
+        let aff = self.material.terms.affine(c);
+        let mut sh = self.point_shading(n, cfg.wi, frame);
+        if let Some(sc) = &self.slope_color {
+            let cs = slope_mean(
+                loc.stats.slope_mean,
+                &loc.stats.slope_cov,
+                self.material.filtering.slope_points as usize,
+                |n| sc.sample(*frame * n),
+            );
+            sh.cs_cos = cs.map(|v| v * sh.cos);
+            sh.cs_env = [0, 1, 2].map(|k| cs[k] * sh.env[k]);
+        }
+        let spec = self
+            .material
             .brdf
-            .shade(c, n, cfg.wo, cfg.wi)
-            .map(|v| v * lit(cfg, n))
+            .specular_with(n, cfg.wo, cfg.wi, SlopeCov::default());
+        let v = sun_visible * lit(cfg, n);
+        self.radiance(aff, aff, &sh, v, spec)
     }
 
     /// The filtered model (see the module docs).
     pub fn filtered(&self, cfg: &Config) -> [f64; 3] {
+        self.filtered_lit(cfg, 1.0, &DMat3::IDENTITY)
+    }
+
+    fn filtered_lit(&self, cfg: &Config, sun_visible: f64, frame: &DMat3) -> [f64; 3] {
         let loc = self.local(cfg);
         let nbar = normal_of(loc.stats.slope_mean);
         let (t, b) = basis(nbar);
@@ -294,15 +452,20 @@ impl Prepared {
         let sigma = loc.stats.slope_cov;
         let f = &self.material.filtering;
         let ms = MaskingShadowing::from_directions(wo, wi, &sigma, f.correlation);
-        let hm = height_moments(ms.total, f.height_filter);
         let (m, s) = self.input_distribution(&loc);
-        let color = self.color_of_distribution(
-            m + s * hm.mean,
-            s * hm.std,
-            ms.total,
-            (hm.mean, hm.std),
-            s * s,
-        );
+        let terms = &self.material.terms;
+        // The colour model over the visible and lit heights (L = Λo + Λi) for the directional
+        // light, over the visible heights (L = Λo) for the unshadowed environment.
+        let filtered_color = |l: f64| {
+            let hm = height_moments(l, f.height_filter);
+            self.color_of_distribution(m + s * hm.mean, s * hm.std, l, (hm.mean, hm.std), s * s)
+        };
+        let sun_color = terms.affine(filtered_color(ms.total));
+        let env_color = if self.environment.is_some() {
+            terms.affine(filtered_color(ms.lambda_o))
+        } else {
+            sun_color
+        };
         let vbar = if wi.z > 0.0 && cfg.wi.z > 0.0 {
             ms.mean_shadowing()
         } else {
@@ -311,12 +474,9 @@ impl Prepared {
         let brdf = &self.material.brdf;
         // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
         let mean = loc.stats.slope_mean;
-        let points = f.slope_points as usize;
-        let diffuse = brdf.albedo
-            * FRAC_1_PI
-            * visible_slope_mean(mean, &sigma, cfg.wo, points, |n| n.dot(cfg.wi).max(0.0));
+        let shading = self.visible_shading(mean, &sigma, cfg.wo, cfg.wi, frame);
         let spec = filtered_specular(brdf.specular, brdf.roughness, mean, &sigma, cfg.wo, cfg.wi);
-        color.map(|c| vbar * (c * diffuse + spec))
+        self.radiance(sun_color, env_color, &shading, sun_visible * vbar, spec)
     }
 
     /// Ground truth by ray tracing the explicit surface with `samples` eye rays drawn from the
@@ -400,10 +560,35 @@ impl Prepared {
         let p = o + dir * t;
         let (f, _h, grad) = s.sample(DVec2::new(p.x, p.y));
         let n = normal_of(grad);
-        if n.dot(wi) <= 0.0 || wi.z <= 0.0 || !s.sees(p, wi) {
+        self.shade_hit(f, n, -dir, wi, &DMat3::IDENTITY, || s.sees(p, wi))
+    }
+
+    /// Radiance of an explicit surface point with driver value f and unit micro-normal n (local
+    /// frame, as ωo and ωi; `frame` to the world), `sees_light` the shadow ray (cast only when the
+    /// directional light can contribute): the base BRDF under the directional light, plus the
+    /// environment's irradiance at the micro-normal (unshadowed, see [`crate::environment`]).
+    pub(crate) fn shade_hit(
+        &self,
+        f: f64,
+        n: DVec3,
+        wo: DVec3,
+        wi: DVec3,
+        frame: &DMat3,
+        sees_light: impl FnOnce() -> bool,
+    ) -> [f64; 3] {
+        // (Below the plane's horizon the plane's shadow ray fails; the cylinder's local light may
+        // be below its tangent plane and still reach a facet.)
+        let lit = n.dot(wi) > 0.0 && self.material.lighting.sun > 0.0;
+        if !lit && self.environment.is_none() {
             return [0.0; 3];
         }
-        self.material.brdf.shade(self.color_at(f), n, -dir, wi)
+        let v = if lit && sees_light() { 1.0 } else { 0.0 };
+        let aff = self.material.terms.affine(self.color_at(f));
+        let spec = self
+            .material
+            .brdf
+            .specular_with(n, wo, wi, SlopeCov::default());
+        self.radiance(aff, aff, &self.point_shading(n, wi, frame), v, spec)
     }
 }
 
@@ -464,6 +649,20 @@ impl Prepared {
         wi: DVec3,
         fp: Footprint,
     ) -> [f64; 3] {
+        self.pixel_in_frame(method, origin, dir, wi, fp, &DMat3::IDENTITY)
+    }
+
+    /// [`Prepared::pixel`] in a tangent frame whose axes in the world are `frame`'s columns (the
+    /// cylinder's): slope colour and environment are looked up at world normals.
+    pub fn pixel_in_frame(
+        &self,
+        method: Method,
+        origin: DVec3,
+        dir: DVec3,
+        wi: DVec3,
+        fp: Footprint,
+        frame: &DMat3,
+    ) -> [f64; 3] {
         if dir.z >= 0.0 {
             return [0.0; 3];
         }
@@ -474,7 +673,8 @@ impl Prepared {
             return [0.0; 3];
         };
         let p = o + dir * t;
-        if wi.z <= 0.0 || self.lod_march(p, wi, fp).is_some() {
+        let sun_visible = wi.z > 0.0 && self.lod_march(p, wi, fp).is_none();
+        if !sun_visible && self.environment.is_none() {
             return [0.0; 3];
         }
         let cfg = Config {
@@ -483,10 +683,11 @@ impl Prepared {
             x0: DVec2::new(p.x, p.y),
             footprint: fp,
         };
+        let v = if sun_visible { 1.0 } else { 0.0 };
         match method {
-            Method::Naive => self.naive(&cfg),
-            Method::ViewIndependent => self.view_independent(&cfg),
-            Method::Filtered => self.filtered(&cfg),
+            Method::Naive => self.naive_lit(&cfg, v, frame),
+            Method::ViewIndependent => self.view_independent_lit(&cfg, v, frame),
+            Method::Filtered => self.filtered_lit(&cfg, v, frame),
         }
     }
 }
@@ -560,21 +761,62 @@ pub fn visible_slope_mean(
     n: usize,
     q: impl Fn(DVec3) -> f64,
 ) -> f64 {
+    let mut num = 0.0;
+    let den = visible_slope_nodes(mean, sigma, wo, n, |n, w| num += w * q(n));
+    if den > 0.0 { num / den } else { 0.0 }
+}
+
+/// The weighted Gauss–Hermite nodes of the visible slope distribution D_s ∝ N(s; s̄, Σ)·u⁺(s),
+/// `u(s) = ωo_z − s·ωo_xy` [HNPN14 Sec. 5.2]: `visit(n(s), w)` for each of the n×n nodes of
+/// N(s̄, Σ) with positive weight `w = w_a w_b u⁺(s)`; returns the sum of the weights (divide by it).
+/// (The Gaussian approximation of D_s, [`crate::visible_slopes::VisibleSlopes`], was measured against
+/// this rule: it has a 3–5% floor at 60°–80°, this rule converges; see that module.)
+pub fn visible_slope_nodes(
+    mean: DVec2,
+    sigma: &SlopeCov,
+    wo: DVec3,
+    n: usize,
+    mut visit: impl FnMut(DVec3, f64),
+) -> f64 {
     let (x, w) = hermite_rule(n);
     let (l11, l21, l22) = cholesky(sigma.xx, sigma.xy, sigma.yy);
-    let (mut num, mut den) = (0.0, 0.0);
+    let mut den = 0.0;
     for (xa, wa) in x.iter().zip(w) {
         for (xb, wb) in x.iter().zip(w) {
             let s = mean + DVec2::new(l11 * xa, l21 * xa + l22 * xb);
             let u = (wo.z - s.x * wo.x - s.y * wo.y).max(0.0);
             let wt = wa * wb * u;
             if wt > 0.0 {
-                num += wt * q(normal_of(s));
+                visit(normal_of(s), wt);
                 den += wt;
             }
         }
     }
-    if den > 0.0 { num / den } else { 0.0 }
+    den
+}
+
+/// `E[q(n(s))]` over N(s̄, Σ) without any visibility weight (n×n Gauss–Hermite): the footprint
+/// average of a slope-indexed texture.
+pub fn slope_mean(
+    mean: DVec2,
+    sigma: &SlopeCov,
+    n: usize,
+    q: impl Fn(DVec3) -> [f64; 3],
+) -> [f64; 3] {
+    let (x, w) = hermite_rule(n);
+    let (l11, l21, l22) = cholesky(sigma.xx, sigma.xy, sigma.yy);
+    let mut acc = [0.0; 3];
+    for (xa, wa) in x.iter().zip(w) {
+        for (xb, wb) in x.iter().zip(w) {
+            let v = q(normal_of(
+                mean + DVec2::new(l11 * xa, l21 * xa + l22 * xb),
+            ));
+            for c in 0..3 {
+                acc[c] += wa * wb * v[c];
+            }
+        }
+    }
+    acc
 }
 
 /// `E[u⁺]` for `u = a − s·b` with `s ~ N(mean, Σ)`: `mΦ(m/√v) + √v φ(m/√v)`, `m = a − mean·b`,
@@ -821,6 +1063,72 @@ pub(crate) mod tests {
                 }
             }
         }
+    }
+
+    /// Slope colour (sun only), environment only, and both combined multiplicatively with the
+    /// height colour: filtered within 3% of ground truth up to 60° on a far footprint (measured:
+    /// 1.0–1.3% at 0°, 2.6–3.0% at 60° for slope colour under a shadowing sun, ≤ 0.6% for the
+    /// environment alone), while
+    /// naive (colour and irradiance at the mean normal) is visibly off in at least one case.
+    #[test]
+    fn slope_colour_and_environment_filter_to_ground_truth() {
+        use crate::color_terms::{CombineMode, SlopeTerm};
+        use crate::environment::{Environment, EnvironmentSource, Lighting, Sky};
+        use crate::slope_color::SlopeColor;
+        let snow = SlopeTerm {
+            color: SlopeColor::snow(),
+            weight: 1.0,
+        };
+        let sky = Environment {
+            source: EnvironmentSource::Sky(Sky::default()),
+            intensity: 1.0,
+        };
+        let mut cases = Vec::new();
+        let mut m = gaussian_material();
+        m.terms.height = None;
+        m.terms.slope = Some(snow.clone());
+        cases.push(("slope colour, sun", m.clone()));
+        let mut m = gaussian_material();
+        m.lighting = Lighting {
+            sun: 0.0,
+            environment: Some(sky.clone()),
+        };
+        cases.push(("environment only", m));
+        let mut m = gaussian_material();
+        m.terms.mode = CombineMode::Multiplicative;
+        m.terms.slope = Some(SlopeTerm {
+            weight: 0.8,
+            ..snow
+        });
+        m.lighting.environment = Some(sky);
+        cases.push(("height x slope colour, sun + sky", m));
+        let mut naive_off = 0.0_f64;
+        for (name, m) in cases {
+            let p = Prepared::new(&m).unwrap();
+            for deg in [0.0_f64, 30.0, 60.0] {
+                let cfg = far(
+                    direction(deg.to_radians(), 0.3),
+                    direction(0.5, 2.0),
+                );
+                let gt = p.ground_truth(&cfg, 60_000, 23);
+                let fi = p.filtered(&cfg);
+                let na = p.naive(&cfg);
+                eprintln!("{name} {deg}: fi {fi:.4?} na {na:.4?} gt {:.4?} ± {:.4?}", gt.mean, gt.std_error);
+                for k in 0..3 {
+                    let rel = (fi[k] - gt.mean[k]).abs() / gt.mean[k];
+                    naive_off = naive_off.max((na[k] - gt.mean[k]).abs() / gt.mean[k]);
+                    assert!(
+                        rel < 0.03,
+                        "{name}, view {deg}°, channel {k}: filtered {} vs truth {} ± {} ({:.2}%)",
+                        fi[k],
+                        gt.mean[k],
+                        gt.std_error[k],
+                        100.0 * rel
+                    );
+                }
+            }
+        }
+        assert!(naive_off > 0.1, "naive should be visibly wrong somewhere: {naive_off}");
     }
 
     #[test]

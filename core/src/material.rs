@@ -8,6 +8,8 @@
 //! the scale of the driver before g, and the surface's statistics follow from [HNPN14 Eqs. 19–26].
 
 use crate::brdf::BaseBrdf;
+use crate::color_terms::ColorTerms;
+use crate::environment::Lighting;
 use crate::colormap::Gradient;
 use crate::effective_height::HeightFilter;
 use crate::noise::{NoiseParams, SumOfSines};
@@ -136,14 +138,21 @@ pub struct Material {
     pub heights: Heights,
     /// Slopes.
     pub slopes: Slopes,
-    /// Colour.
+    /// Colour: the height- or driver-correlated colour model C_h.
     pub color: ColorModel,
+    /// Which colour terms (constant C0, the colour model C_h, slope colour C_s) combine, and how
+    /// [HNPN14 Sec. 6]. Default: the colour model alone.
+    #[serde(default)]
+    pub terms: ColorTerms,
     /// Base BRDF.
     #[serde(default)]
     pub brdf: BaseBrdf,
     /// Filtering options.
     #[serde(default)]
     pub filtering: Filtering,
+    /// The preview lighting saved with the material: directional light scale and environment.
+    #[serde(default)]
+    pub lighting: Lighting,
 }
 
 /// Errors reading a material.
@@ -199,6 +208,8 @@ impl Default for Material {
                 roughness: 0.15,
             },
             filtering: Filtering::default(),
+            terms: ColorTerms::default(),
+            lighting: Lighting::default(),
         }
     }
 }
@@ -286,6 +297,8 @@ impl Material {
                 }
             }
         }
+        self.terms.validate(&mut p);
+        self.lighting.validate(&mut p);
         p.in_range("brdf.albedo", self.brdf.albedo, 0.0, 1.0);
         p.in_range("brdf.specular", self.brdf.specular, 0.0, 1.0);
         p.in_range("brdf.roughness", self.brdf.roughness, 0.0, MAX_SIGMA);
