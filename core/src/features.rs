@@ -47,11 +47,15 @@ pub enum Feature {
     Specular,
     /// Curved geometry (the cylinder and its tangent-frame footprints).
     Curved,
+    /// A slope-correlated colour term C_s(n) (its polynomial, averaged over D_s) [HNPN14 Sec. 5.2].
+    SlopeColor,
+    /// Environment lighting: SH9 irradiance per facet, averaged over D_s [HNPN14 Sec. 5.3].
+    Environment,
 }
 
 impl Feature {
     /// Every feature, in a fixed order.
-    pub const ALL: [Feature; 10] = [
+    pub const ALL: [Feature; 12] = [
         Feature::NoiseDriver,
         Feature::ImageDriver,
         Feature::DriverColor,
@@ -62,6 +66,8 @@ impl Feature {
         Feature::Shadows,
         Feature::Specular,
         Feature::Curved,
+        Feature::SlopeColor,
+        Feature::Environment,
     ];
 
     /// The name used in shader directives (`//#if relief`), the CLI and JSON.
@@ -77,6 +83,8 @@ impl Feature {
             Feature::Shadows => "shadows",
             Feature::Specular => "specular",
             Feature::Curved => "curved",
+            Feature::SlopeColor => "slope_color",
+            Feature::Environment => "environment",
         }
     }
 
@@ -93,6 +101,8 @@ impl Feature {
 /// A set of [`Feature`]s (a bit set: cheap to copy, hash and compare; the pipeline cache's key).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct FeatureSet(u16);
+
+const _: () = assert!(Feature::ALL.len() <= 16, "FeatureSet is a u16");
 
 impl FeatureSet {
     /// The empty set.
@@ -139,6 +149,7 @@ impl FeatureSet {
     /// The features of the material alone (no scene): see [`FeatureSet::derive`].
     pub fn of_material(m: &Material) -> FeatureSet {
         let relief = m.heights.sigma_h > 0.0;
+        let colour_model = m.terms.uses_height_term();
         FeatureSet::EMPTY
             .with(Feature::NoiseDriver, matches!(m.driver, Driver::Noise(_)))
             .with(
@@ -147,7 +158,8 @@ impl FeatureSet {
             )
             .with(
                 Feature::DriverColor,
-                matches!(
+                colour_model
+                    && matches!(
                     m.color,
                     ColorModel::Gradient {
                         source: ColorSource::Driver,
@@ -157,7 +169,8 @@ impl FeatureSet {
             )
             .with(
                 Feature::HeightColor,
-                matches!(
+                colour_model
+                    && matches!(
                     m.color,
                     ColorModel::Gradient {
                         source: ColorSource::Height,
@@ -167,7 +180,8 @@ impl FeatureSet {
             )
             .with(
                 Feature::AttributeColor,
-                matches!(m.color, ColorModel::Attribute { .. }),
+                colour_model
+                    && matches!(m.color, ColorModel::Attribute { .. }),
             )
             .with(
                 Feature::TransferCurve,
@@ -175,6 +189,8 @@ impl FeatureSet {
             )
             .with(Feature::Relief, relief)
             .with(Feature::Specular, m.brdf.specular > 0.0)
+            .with(Feature::SlopeColor, m.terms.slope.is_some())
+            .with(Feature::Environment, m.lighting.environment.is_some())
     }
 
     /// The features a material needs in a scene with this object and light (unit direction
@@ -209,6 +225,11 @@ impl FeatureSet {
                 let why = match f {
                     Feature::NoiseDriver => "the driver is an image",
                     Feature::ImageDriver => "the driver is procedural noise",
+                    Feature::DriverColor | Feature::HeightColor | Feature::AttributeColor
+                        if !m.terms.uses_height_term() =>
+                    {
+                        "the colour model is not one of the colour terms"
+                    }
                     Feature::DriverColor | Feature::HeightColor | Feature::AttributeColor => {
                         match m.color {
                             ColorModel::Gradient {
@@ -233,6 +254,8 @@ impl FeatureSet {
                     }
                     Feature::Specular => "the specular weight is 0",
                     Feature::Curved => "the scene is the plane",
+                    Feature::SlopeColor => "the material has no slope colour term",
+                    Feature::Environment => "the lighting has no environment",
                 };
                 (f, why)
             })
@@ -275,7 +298,7 @@ mod tests {
             assert!(!FeatureSet::EMPTY.contains(f));
             assert_eq!(all.with(f, false).iter().count(), Feature::ALL.len() - 1);
         }
-        assert_eq!(Feature::from_name("slope_color"), None);
+        assert_eq!(Feature::from_name("voxels"), None);
         assert!(all.covers(FeatureSet::derive(
             &Material::default(),
             Shape::Plane,

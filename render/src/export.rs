@@ -11,10 +11,12 @@
 //! | `manifest.json` | sizes, ranges and indexing of every table, every `Params` field by name, the API |
 //! | `material.ron` | the preset |
 //!
-//! API of the snippets: `eval_filtered(x0, fp, wo, wi) -> vec3` — linear RGB radiance of the filtered
-//! material for a pixel footprint centred at surface point `x0` (world units) with covariance
-//! `fp = (Σxx, Σyy, Σxy)`, unit view and light directions in the surface frame (z = normal);
-//! `eval_naive` and `eval_view_independent` take the same arguments.
+//! API of the snippets: `eval_filtered(x0, fp, wo, wi, sun_visible) -> vec3` — linear RGB radiance of
+//! the filtered material for a pixel footprint centred at surface point `x0` (world units) with
+//! covariance `fp = (Σxx, Σyy, Σxy)`, unit view and light directions in the surface frame
+//! (z = normal), `sun_visible` ∈ [0, 1] the engine's shadowing of the directional light at the point
+//! (the environment term, if any, is unshadowed); `eval_naive` and `eval_view_independent` take the
+//! same arguments.
 
 use crate::gpu_types::{GpuParams, gpu_params_offsets};
 use crate::renderer::material_data;
@@ -64,7 +66,7 @@ fn lodestone_filtered_main(@builtin(global_invocation_id) id: vec3<u32>) {
     let fp = vec3<f32>(lodestone_inputs[b + 2u], lodestone_inputs[b + 3u], lodestone_inputs[b + 4u]);
     let wo = vec3<f32>(lodestone_inputs[b + 5u], lodestone_inputs[b + 6u], lodestone_inputs[b + 7u]);
     let wi = vec3<f32>(lodestone_inputs[b + 8u], lodestone_inputs[b + 9u], lodestone_inputs[b + 10u]);
-    let c = eval_filtered(x0, fp, wo, wi);
+    let c = eval_filtered(x0, fp, wo, wi, 1.0);
     lodestone_outputs[i * 4u] = c.x;
     lodestone_outputs[i * 4u + 1u] = c.y;
     lodestone_outputs[i * 4u + 2u] = c.z;
@@ -82,7 +84,7 @@ pub fn snippet_wgsl() -> String {
     format!(
         "// Lodestone filtered material, self-contained WGSL (lodestone-core mirrored in f32).\n\
          // Bindings: 0 = Params (params.bin), 1 = data (data.bin); see manifest.json.\n\
-         // API: eval_filtered / eval_naive / eval_view_independent(x0, fp, wo, wi) -> vec3<f32>.\n\n{}\n{}",
+         // API: eval_filtered / eval_naive / eval_view_independent(x0, fp, wo, wi, sun_visible) -> vec3<f32>.\n\n{}\n{}",
         material, EXAMPLE
     )
 }

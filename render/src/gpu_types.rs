@@ -70,6 +70,18 @@ pub struct GpuParams {
     pub image_v0: f32,
     pub image_lip_x: f32,
     pub image_lip_y: f32,
+    pub c0: [f32; 3],
+    pub kappa0: f32,
+    pub sc_dir: [f32; 3],
+    pub kappa2: f32,
+    pub kappa1: f32,
+    pub combine_mode: u32,
+    pub sun: f32,
+    pub sp_knots: u32,
+    pub sp_offset: u32,
+    pub env_offset: u32,
+    pub has_env: u32,
+    pub pad1: u32,
 }
 
 /// Field names and byte offsets of [`GpuParams`], in declaration order (for the layout test).
@@ -139,6 +151,18 @@ pub fn gpu_params_offsets() -> Vec<(&'static str, usize)> {
         image_u0,
         image_v0,
         image_lip_x,
-        image_lip_y
+        image_lip_y,
+        c0,
+        kappa0,
+        sc_dir,
+        kappa2,
+        kappa1,
+        combine_mode,
+        sun,
+        sp_knots,
+        sp_offset,
+        env_offset,
+        has_env,
+        pad1
     )
 }

@@ -12,6 +12,7 @@ use lodestone_core::driver_field::{DriverField, TiledImage};
 use lodestone_core::effective_height::{EffectiveHeightTable, HeightFilter};
 use lodestone_core::features::{Feature, FeatureSet};
 use lodestone_core::footprint::{Prepared, hermite_rule};
+use lodestone_core::color_terms::CombineMode;
 use lodestone_core::material::{ColorModel, ColorSource};
 use lodestone_core::piecewise::PiecewisePoly;
 use lodestone_core::preconvolved::PreconvolvedTable;
@@ -473,6 +474,36 @@ pub fn material_data_for(
             base.attr_mean = mean.map(|v| v as f32);
             base.attr_corr = correlation.map(|v| v as f32);
         }
+    }
+    // Colour terms: an absent term has weight 0 (see material.wgsl's `affine`).
+    let terms = &m.terms;
+    base.combine_mode = u32::from(terms.mode == CombineMode::Multiplicative);
+    if let Some(c) = &terms.constant {
+        base.c0 = c.color.map(|v| v as f32);
+        base.kappa0 = c.weight as f32;
+    }
+    base.kappa1 = terms.height.unwrap_or(0.0) as f32;
+    if let (Some(t), Some(sc)) = (&terms.slope, &prepared.slope_color) {
+        base.kappa2 = t.weight as f32;
+        base.sc_dir = sc.direction.to_array().map(|v| v as f32);
+        if features.contains(Feature::SlopeColor) {
+            let start = data.len();
+            base.sp_offset = push_poly(&mut data, &sc.poly, &[0, 1, 2]);
+            base.sp_knots = sc.poly.knots.len() as u32;
+            mark(&data, start, "slope colour polynomial");
+        }
+    }
+    base.sun = m.lighting.sun as f32;
+    if let Some(env) = &prepared.environment
+        && features.contains(Feature::Environment)
+    {
+        let start = data.len();
+        base.env_offset = data.len() as u32;
+        base.has_env = 1;
+        for c in env.irradiance_coefficients() {
+            data.extend(c.map(|v| v as f32));
+        }
+        mark(&data, start, "environment SH9");
     }
     if let TransferFunction::Curve(c) = &m.heights.transfer {
         let p = c.moment_poly();

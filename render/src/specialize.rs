@@ -298,7 +298,7 @@ mod tests {
             SpecializeError::Unmatched { line: 3, .. }
         ));
         assert!(matches!(
-            e("//#if slope_color\n//#endif\n"),
+            e("//#if voxels\n//#endif\n"),
             SpecializeError::UnknownFeature { line: 1, .. }
         ));
         assert!(matches!(

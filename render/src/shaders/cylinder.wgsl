@@ -121,17 +121,23 @@ fn cylinder_trace_ray(origin: vec3<f32>, dir: vec3<f32>, wi: vec3<f32>) -> vec3<
     let gd = transfer_eval(fg.x);
     let grad = fg.yz * (params.sigma_h * gd.y);
     let n = normal_of(vec2<f32>(grad.x, grad.y * r / max(s.z, 1e-30)));
-    let fr = transpose(cylinder_frame(s.w));
+    shading_frame = cylinder_frame(s.w);
+    let fr = transpose(shading_frame);
     let wo_l = fr * -dir;
     let wi_l = fr * wi;
-    if (dot(n, wi_l) <= 0.0) {
+    // Prepared::shade_hit with the cylinder's shadow ray.
+    let lit = dot(n, wi_l) > 0.0 && params.sun > 0.0;
+    if (!lit && !has_environment()) {
         return vec3<f32>(0.0);
     }
-    let shadow = cylinder_intersect(outer, p, wi);
-    if (shadow.y >= 0.0 && cylinder_march(p, wi, shadow.y) >= 0.0) {
-        return vec3<f32>(0.0);
+    var v = select(0.0, 1.0, lit);
+    if (lit) {
+        let shadow = cylinder_intersect(outer, p, wi);
+        if (shadow.y >= 0.0 && cylinder_march(p, wi, shadow.y) >= 0.0) {
+            v = 0.0;
+        }
     }
-    return shade(color_at(fg.x), n, wo_l, wi_l);
+    return shade_point(fg.x, n, wo_l, wi_l, v);
 }
 
 // Camera::tangent_footprint (view.wgsl's pixel steps dx, dy): covariance (xx, yy, xy) in (t_u, t_v).
@@ -157,6 +163,7 @@ fn cylinder_pixel(method: u32, d: vec3<f32>, dx: vec3<f32>, dy: vec3<f32>, wi: v
     let hit = params.eye + dir * span.x;
     let s = cylinder_to_surface(hit);
     let fr = cylinder_frame(s.w);
+    shading_frame = fr;
     let fp = tangent_footprint(d, dx, dy, hit, fr);
     let frt = transpose(fr);
     let q = frt * (params.eye - hit);

@@ -77,6 +77,19 @@ struct Params {
     image_v0: f32,
     image_lip_x: f32,
     image_lip_y: f32,
+    // Colour terms (ColorTerms; an absent term has weight 0) and lighting.
+    c0: vec3<f32>,
+    kappa0: f32,
+    sc_dir: vec3<f32>,
+    kappa2: f32,
+    kappa1: f32,
+    combine_mode: u32,
+    sun: f32,
+    sp_knots: u32,
+    sp_offset: u32,
+    env_offset: u32,
+    has_env: u32,
+    pad1: u32,
 }
 
 @group(0) @binding(0) var<storage, read> params: Params;
@@ -136,7 +149,7 @@ fn height_moments(l_in: f32) -> vec2<f32> {
 //#endif
 
 // ---------------------------------------------------------------- piecewise.rs (eval, degree ≤ 3)
-//#if driver_color|height_color|transfer_curve
+//#if driver_color|height_color|transfer_curve|slope_color
 // Layout at `off`: knots[k], then per segment per channel 4 coefficients, then left[ch], right[ch].
 fn poly_eval(off: u32, k: u32, channels: u32, ch: u32, x: f32) -> f32 {
     let coeff = off + k;
@@ -389,6 +402,100 @@ fn shade(color: vec3<f32>, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f
     return color * d + vec3<f32>(s);
 }
 
+// ---------------------------------------------------------------- color_terms.rs, slope_color.rs, sh.rs
+// ColorTerms::affine: C = a + k ⊙ C_s for colour-model value ch (absent terms have weight 0, which
+// is "no contribution" when linear and "white" when multiplicative).
+struct Affine {
+    a: vec3<f32>,
+    k: vec3<f32>,
+}
+
+fn affine(ch: vec3<f32>) -> Affine {
+    var r: Affine;
+    if (params.combine_mode == 1u) {
+        let p = (vec3<f32>(1.0 - params.kappa0) + params.kappa0 * params.c0) * (vec3<f32>(1.0 - params.kappa1) + params.kappa1 * ch);
+        r.a = p * (1.0 - params.kappa2);
+        r.k = p * params.kappa2;
+        return r;
+    }
+    r.a = params.kappa0 * params.c0 + params.kappa1 * ch;
+    r.k = vec3<f32>(params.kappa2);
+    return r;
+}
+
+// Prepared::slope_color_at (CompiledSlopeColor::sample) at a world normal.
+fn slope_color_at(nw: vec3<f32>) -> vec3<f32> {
+//#if slope_color
+    let k = params.sp_knots;
+    if (k == 0u) {
+        return vec3<f32>(0.0);
+    }
+    let t = dot(nw, params.sc_dir);
+    return vec3<f32>(poly_eval(params.sp_offset, k, 3u, 0u, t), poly_eval(params.sp_offset, k, 3u, 1u, t), poly_eval(params.sp_offset, k, 3u, 2u, t));
+//#else
+    return vec3<f32>(0.0);
+//#endif
+}
+
+// Sh9::irradiance (coefficients pre-multiplied by Â_l, coefficient-major RGB) at a world normal.
+fn environment_at(nw: vec3<f32>) -> vec3<f32> {
+//#if environment
+    if (params.has_env == 0u) {
+        return vec3<f32>(0.0);
+    }
+    let o = params.env_offset;
+    let x = nw.x;
+    let y = nw.y;
+    let z = nw.z;
+    let b = array<f32, 9>(0.282095, 0.488603 * y, 0.488603 * z, 0.488603 * x, 1.092548 * x * y, 1.092548 * y * z, 0.315392 * (3.0 * z * z - 1.0), 1.092548 * x * z, 0.546274 * (x * x - y * y));
+    var e = vec3<f32>(0.0);
+    for (var i = 0u; i < 9u; i = i + 1u) {
+        e = e + b[i] * vec3<f32>(data[o + 3u * i], data[o + 3u * i + 1u], data[o + 3u * i + 2u]);
+    }
+    return max(e, vec3<f32>(0.0));
+//#else
+    return vec3<f32>(0.0);
+//#endif
+}
+
+// The tangent frame's axes in the world (identity on the plane; the cylinder sets its own before
+// shading): slope colour and environment are looked up at world normals.
+var<private> shading_frame: mat3x3<f32> = mat3x3<f32>(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+
+struct SlopeShading {
+    cos: f32,
+    cs_cos: vec3<f32>,
+    env: vec3<f32>,
+    cs_env: vec3<f32>,
+}
+
+// Prepared::point_shading.
+fn point_shading(n: vec3<f32>, wi: vec3<f32>) -> SlopeShading {
+    var r: SlopeShading;
+    r.cos = max(dot(n, wi), 0.0);
+    let nw = shading_frame * n;
+    let cs = slope_color_at(nw);
+    r.env = environment_at(nw);
+    r.cs_cos = cs * r.cos;
+    r.cs_env = cs * r.env;
+    return r;
+}
+
+// Prepared::radiance.
+fn radiance(sun_color: Affine, env_color: Affine, s: SlopeShading, v: f32, spec: f32) -> vec3<f32> {
+    let sun = params.sun * v;
+    let kd = params.albedo * FRAC_1_PI;
+    return kd * (sun * (sun_color.a * s.cos + sun_color.k * s.cs_cos) + env_color.a * s.env + env_color.k * s.cs_env) + vec3<f32>(sun * spec);
+}
+
+fn has_environment() -> bool {
+//#if environment
+    return params.has_env != 0u;
+//#else
+    return false;
+//#endif
+}
+
 // ---------------------------------------------------------------- footprint.rs
 //#if relief
 fn cholesky(c: vec3<f32>) -> vec3<f32> {
@@ -400,11 +507,16 @@ fn cholesky(c: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(l11, l21, sqrt(max(c.y - l21 * l21, 0.0)));
 }
 
-// visible_slope_mean with q(n) = (n·ωi)⁺, world slope space, slopes N(mean, cov), n×n Gauss–Hermite.
-fn visible_slope_mean_cos(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+// Prepared::visible_shading: point_shading averaged on the weighted Gauss–Hermite nodes of D_s
+// (visible_slope_nodes), world slope space, slopes N(mean, cov).
+fn visible_shading(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> SlopeShading {
     let l = cholesky(cov);
     let n = params.slope_points;
-    var num = 0.0;
+    var acc: SlopeShading;
+    acc.cos = 0.0;
+    acc.cs_cos = vec3<f32>(0.0);
+    acc.env = vec3<f32>(0.0);
+    acc.cs_env = vec3<f32>(0.0);
     var den = 0.0;
     for (var a = 0u; a < n; a = a + 1u) {
         let xa = data[params.gh_offset + 2u * a];
@@ -416,16 +528,44 @@ fn visible_slope_mean_cos(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: ve
             let u = max(wo.z - s.x * wo.x - s.y * wo.y, 0.0);
             let wt = wa * wb * u;
             if (wt > 0.0) {
-                num = num + wt * max(dot(normal_of(s), wi), 0.0);
+                let p = point_shading(normal_of(s), wi);
+                acc.cos = acc.cos + wt * p.cos;
+                acc.cs_cos = acc.cs_cos + wt * p.cs_cos;
+                acc.env = acc.env + wt * p.env;
+                acc.cs_env = acc.cs_env + wt * p.cs_env;
                 den = den + wt;
             }
         }
     }
     if (den > 0.0) {
-        return num / den;
+        let inv = 1.0 / den;
+        acc.cos = acc.cos * inv;
+        acc.cs_cos = acc.cs_cos * inv;
+        acc.env = acc.env * inv;
+        acc.cs_env = acc.cs_env * inv;
     }
-    return 0.0;
+    return acc;
 }
+
+//#if slope_color
+// footprint::slope_mean of C_s: the footprint average without visibility weight.
+fn slope_color_mean(mean: vec2<f32>, cov: vec3<f32>) -> vec3<f32> {
+    let l = cholesky(cov);
+    let n = params.slope_points;
+    var acc = vec3<f32>(0.0);
+    for (var a = 0u; a < n; a = a + 1u) {
+        let xa = data[params.gh_offset + 2u * a];
+        let wa = data[params.gh_offset + 2u * a + 1u];
+        for (var b = 0u; b < n; b = b + 1u) {
+            let xb = data[params.gh_offset + 2u * b];
+            let wb = data[params.gh_offset + 2u * b + 1u];
+            let s = mean + vec2<f32>(l.x * xa, l.y * xa + l.z * xb);
+            acc = acc + (wa * wb) * slope_color_at(shading_frame * normal_of(s));
+        }
+    }
+    return acc;
+}
+//#endif
 //#endif
 
 // footprint::filtered_specular (world slope space, facet slopes N(mean, cov)).
@@ -549,20 +689,34 @@ fn lit(wi: vec3<f32>, n: vec3<f32>) -> f32 {
     return select(0.0, 1.0, wi.z > 0.0 && dot(n, wi) > 0.0);
 }
 
-// Prepared::naive.
-fn eval_naive(x0: vec2<f32>, fp: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+// Prepared::naive (sun_visible: the directional light's shadow test on the level-of-detail surface).
+fn eval_naive(x0: vec2<f32>, fp: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, sun_visible: f32) -> vec3<f32> {
     let loc = local_stats(x0, fp);
     let n = normal_of(loc.stats.slope_mean);
-    return shade(color_at(loc.driver.mean), n, wo, wi) * lit(wi, n);
+    let aff = affine(color_at(loc.driver.mean));
+    let spec = specular_with(n, wo, wi, vec3<f32>(0.0));
+    return radiance(aff, aff, point_shading(n, wi), sun_visible * lit(wi, n), spec);
 }
 
 // Prepared::view_independent.
-fn eval_view_independent(x0: vec2<f32>, fp: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+fn eval_view_independent(x0: vec2<f32>, fp: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, sun_visible: f32) -> vec3<f32> {
     let loc = local_stats(x0, fp);
     let ms = input_distribution(loc);
     let c = color_of_distribution(ms.x, ms.y, 0.0, vec2<f32>(0.0, 1.0), ms.y * ms.y);
     let n = normal_of(loc.stats.slope_mean);
-    return shade(c, n, wo, wi) * lit(wi, n);
+    let aff = affine(c);
+    var sh = point_shading(n, wi);
+//#if slope_color
+//#if relief
+    let cs = slope_color_mean(loc.stats.slope_mean, loc.stats.slope_cov);
+//#else
+    let cs = slope_color_at(shading_frame * n);
+//#endif
+    sh.cs_cos = cs * sh.cos;
+    sh.cs_env = cs * sh.env;
+//#endif
+    let spec = specular_with(n, wo, wi, vec3<f32>(0.0));
+    return radiance(aff, aff, sh, sun_visible * lit(wi, n), spec);
 }
 
 //#if relief
@@ -583,7 +737,7 @@ fn basis_b(n: vec3<f32>) -> vec3<f32> {
 //#endif
 
 // Prepared::filtered.
-fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>) -> vec3<f32> {
+fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>, sun_visible: f32) -> vec3<f32> {
     let loc = local_stats(x0, fp);
 //#if relief
     let nbar = normal_of(loc.stats.slope_mean);
@@ -596,9 +750,16 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>)
     }
     let cov = loc.stats.slope_cov;
     let ms = masking(wo, wi, cov);
-    let hm = height_moments(ms.w);
     let d = input_distribution(loc);
-    let color = color_of_distribution(d.x + d.y * hm.x, d.y * hm.y, ms.w, hm, d.y * d.y);
+    // The colour model over the visible and lit heights (L = Λo + Λi) for the directional light,
+    // over the visible heights (L = Λo) for the unshadowed environment.
+    let hm = height_moments(ms.w);
+    let sun_color = affine(color_of_distribution(d.x + d.y * hm.x, d.y * hm.y, ms.w, hm, d.y * d.y));
+    var env_color = sun_color;
+//#if environment
+    let hmo = height_moments(ms.x);
+    env_color = affine(color_of_distribution(d.x + d.y * hmo.x, d.y * hmo.y, ms.x, hmo, d.y * d.y));
+//#endif
     var vbar = 0.0;
     if (wi.z > 0.0 && wi_w.z > 0.0) {
         // Kept without the shadows feature: a light at the world normal is oblique to a tilted
@@ -607,20 +768,19 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>)
     }
     // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
     let s_mean = loc.stats.slope_mean;
-    let diffuse = params.albedo * FRAC_1_PI * visible_slope_mean_cos(s_mean, cov, wo_w, wi_w);
+    let shading = visible_shading(s_mean, cov, wo_w, wi_w);
     let spec = filtered_specular(s_mean, cov, wo_w, wi_w);
-    return vbar * (color * diffuse + vec3<f32>(spec));
+    return radiance(sun_color, env_color, shading, sun_visible * vbar, spec);
 //#else
     // Flat: every facet faces +z, nothing masks or shadows (Λ = 0, and D_h at L = 0 is the
     // identity, so the colour is that of the footprint's own distribution).
-    if (wo_w.z <= 0.0 || wi_w.z <= 0.0) {
+    if (wo_w.z <= 0.0) {
         return vec3<f32>(0.0);
     }
     let d = input_distribution(loc);
-    let color = color_of_distribution(d.x, d.y, 0.0, vec2<f32>(0.0, 1.0), d.y * d.y);
-    let diffuse = params.albedo * FRAC_1_PI * wi_w.z;
+    let aff = affine(color_of_distribution(d.x, d.y, 0.0, vec2<f32>(0.0, 1.0), d.y * d.y));
     let spec = filtered_specular(vec2<f32>(0.0), vec3<f32>(0.0), wo_w, wi_w);
-    return color * diffuse + vec3<f32>(spec);
+    return radiance(aff, aff, point_shading(vec3<f32>(0.0, 0.0, 1.0), wi_w), sun_visible * select(0.0, 1.0, wi_w.z > 0.0), spec);
 //#endif
 }
 
@@ -758,15 +918,29 @@ fn trace_ray(origin: vec3<f32>, dir: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
     let fg = value_and_gradient(p.xy);
     let n = vec3<f32>(0.0, 0.0, 1.0);
 //#endif
-    if (dot(n, wi) <= 0.0 || wi.z <= 0.0) {
+    return shade_hit(fg.x, n, -dir, wi, p);
+}
+
+// Prepared::shade_hit on the plane (the shadow ray only when the directional light can contribute).
+fn shade_hit(f: f32, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, p: vec3<f32>) -> vec3<f32> {
+    let lit = dot(n, wi) > 0.0 && params.sun > 0.0;
+    if (!lit && !has_environment()) {
         return vec3<f32>(0.0);
     }
+    var v = select(0.0, 1.0, lit && wi.z > 0.0);
 //#if shadows
-    if (!sees(p, wi)) {
-        return vec3<f32>(0.0);
+    if (v > 0.0 && !sees(p, wi)) {
+        v = 0.0;
     }
 //#endif
-    return shade(color_at(fg.x), n, -dir, wi);
+    return shade_point(f, n, wo, wi, v);
+}
+
+// The end of Prepared::shade_hit: colour terms and radiance at a facet with light visibility v.
+fn shade_point(f: f32, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, v: f32) -> vec3<f32> {
+    let aff = affine(color_at(f));
+    let spec = specular_with(n, wo, wi, vec3<f32>(0.0));
+    return radiance(aff, aff, point_shading(n, wi), v, spec);
 }
 
 // ---------------------------------------------------------------- footprint.rs (level-of-detail surface)
@@ -874,18 +1048,19 @@ fn analytic_pixel(method: u32, origin: vec3<f32>, dir: vec3<f32>, wi: vec3<f32>,
     // Flat: the plane z = 0.
     let p = origin + dir * (-origin.z / dir.z);
 //#endif
-    if (wi.z <= 0.0) {
-        return vec3<f32>(0.0);
-    }
+    var v = select(0.0, 1.0, wi.z > 0.0);
 //#if shadows
-    if (lod_march(p, wi, sf) >= 0.0) {
-        return vec3<f32>(0.0);
+    if (v > 0.0 && lod_march(p, wi, sf) >= 0.0) {
+        v = 0.0;
     }
 //#endif
-    if (method == 0u) {
-        return eval_naive(p.xy, fp, -dir, wi);
-    } else if (method == 1u) {
-        return eval_view_independent(p.xy, fp, -dir, wi);
+    if (v == 0.0 && !has_environment()) {
+        return vec3<f32>(0.0);
     }
-    return eval_filtered(p.xy, fp, -dir, wi);
+    if (method == 0u) {
+        return eval_naive(p.xy, fp, -dir, wi, v);
+    } else if (method == 1u) {
+        return eval_view_independent(p.xy, fp, -dir, wi, v);
+    }
+    return eval_filtered(p.xy, fp, -dir, wi, v);
 }
