@@ -4,7 +4,9 @@
 //! renamed over the target, so a crash mid-save never leaves a truncated preset.
 
 use lodestone_core::footprint::{PrepareError, Prepared};
+use lodestone_core::environment::{Environment, EnvironmentSource, EquirectMap};
 use lodestone_core::image_driver::ImageDriver;
+use lodestone_core::sh::Sh9;
 use lodestone_core::material::{Driver, Material, MaterialError};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -43,6 +45,16 @@ pub enum PresetError {
         /// What is wrong (missing, not an image, too large, not finite).
         reason: String,
     },
+    /// The lighting's environment file cannot be used.
+    #[error("{preset}: environment {file}: {reason}")]
+    Environment {
+        /// The preset.
+        preset: PathBuf,
+        /// The environment file, resolved against the preset's folder.
+        file: PathBuf,
+        /// What is wrong (missing, not an image, too large, not finite).
+        reason: String,
+    },
     /// The file cannot be written.
     #[error("cannot save {path}: {error}")]
     Write {
@@ -70,6 +82,9 @@ pub struct Resolved {
     pub material: Material,
     /// The driver image, decoded and mip-mapped.
     pub image: Option<Arc<ImageDriver>>,
+    /// The SH9 radiance of the lighting's environment file (before its intensity); `None` without
+    /// a file (the procedural sky needs none).
+    pub environment: Option<Sh9>,
 }
 
 impl Resolved {
@@ -78,12 +93,17 @@ impl Resolved {
         Self {
             material,
             image: None,
+            environment: None,
         }
     }
 
     /// The material's tables and surface, ready for the CPU reference and the GPU.
     pub fn prepare(&self) -> Result<Prepared, PrepareError> {
-        Prepared::with_image(&self.material, self.image.clone(), None)
+        let mut p = Prepared::with_image(&self.material, self.image.clone(), None)?;
+        if let Some(sh) = &self.environment {
+            p.set_environment_radiance(sh);
+        }
+        Ok(p)
     }
 }
 
@@ -98,7 +118,55 @@ pub fn load_resolved(path: &Path) -> Result<Resolved, PresetError> {
         error,
     })?;
     let image = driver_image(&material, Some(path))?;
-    Ok(Resolved { material, image })
+    let environment = environment_file(&material, Some(path))?;
+    Ok(Resolved {
+        material,
+        image,
+        environment,
+    })
+}
+
+/// The SH9 radiance of `material`'s environment file, its path relative to the folder of `preset`;
+/// `None` without an environment file.
+pub fn environment_file(
+    material: &Material,
+    preset: Option<&Path>,
+) -> Result<Option<Sh9>, PresetError> {
+    let Some(Environment {
+        source: EnvironmentSource::File { path },
+        ..
+    }) = &material.lighting.environment
+    else {
+        return Ok(None);
+    };
+    let dir = preset.and_then(|p| p.parent()).unwrap_or(Path::new("."));
+    let full = dir.join(path);
+    load_environment(preset.unwrap_or(Path::new("(unsaved material)")), &full).map(Some)
+}
+
+/// Largest side of an environment file (projection reads every texel once).
+pub const MAX_ENVIRONMENT_SIDE: u32 = 8192;
+
+/// Load an equirectangular `.exr` or `.hdr` (any format the image crate reads) and project it to SH9.
+pub fn load_environment(preset: &Path, file: &Path) -> Result<Sh9, PresetError> {
+    let err = |reason: String| PresetError::Environment {
+        preset: preset.to_owned(),
+        file: file.to_owned(),
+        reason,
+    };
+    let (w, h) = image::image_dimensions(file).map_err(|e| err(e.to_string()))?;
+    if w > MAX_ENVIRONMENT_SIDE || h > MAX_ENVIRONMENT_SIDE {
+        return Err(err(format!(
+            "{w}×{h} is larger than the {MAX_ENVIRONMENT_SIDE}×{MAX_ENVIRONMENT_SIDE} limit"
+        )));
+    }
+    let img = image::open(file)
+        .map_err(|e| err(e.to_string()))?
+        .to_rgb32f();
+    let texels = img.pixels().map(|p| p.0).collect();
+    EquirectMap::new(w as usize, h as usize, texels)
+        .map(|m| m.sh())
+        .map_err(|e| err(e.to_string()))
 }
 
 /// The image of `material`'s driver, its path taken relative to the folder of `preset` (the

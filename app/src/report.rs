@@ -198,7 +198,11 @@ pub fn run_with(
     paper.filtering.height_filter = HeightFilter::PaperFit;
     paper.filtering.correlation = Correlation::Uncorrelated;
     let prepare = |m: &lodestone_core::material::Material| {
-        lodestone_core::footprint::Prepared::with_image(m, preset.image.clone(), None)
+        crate::preset_io::Resolved {
+            material: m.clone(),
+            ..preset.clone()
+        }
+        .prepare()
     };
     let (p_exact, p_paper) = (prepare(&exact)?, prepare(&paper)?);
     let target = [0.3, 0.7];

@@ -188,16 +188,21 @@ impl Prepared {
         })
     }
 
-    /// Use an equirectangular map (loaded by the application for an environment file) as the
-    /// environment, with the material's intensity.
-    pub fn set_environment_map(&mut self, map: &EquirectMap) {
-        let intensity = self
+    /// Use the SH9 radiance of an environment file (projected by the application with
+    /// [`EquirectMap::sh`]) as the environment, scaled by the material's intensity; ignored when
+    /// the material has no environment.
+    pub fn set_environment_radiance(&mut self, radiance: &Sh9) {
+        self.environment = self
             .material
             .lighting
             .environment
             .as_ref()
-            .map_or(0.0, |e| e.intensity);
-        self.environment = Some(map.sh().scaled(intensity));
+            .map(|e| radiance.scaled(e.intensity));
+    }
+
+    /// [`Prepared::set_environment_radiance`] from an equirectangular map.
+    pub fn set_environment_map(&mut self, map: &EquirectMap) {
+        self.set_environment_radiance(&map.sh());
     }
 
     /// `C_s(n)` of the slope term (0 without one).

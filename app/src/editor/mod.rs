@@ -22,7 +22,9 @@ use crate::preset_io;
 use egui::{Key, KeyboardShortcut, Modifiers};
 use history::History;
 use inspector::Inspector;
+use lodestone_core::environment::{Environment, EnvironmentSource};
 use lodestone_core::image_driver::ImageDriver;
+use lodestone_core::sh::Sh9;
 use lodestone_core::material::{Driver, Material};
 use lodestone_render::ViewMode;
 use lodestone_render::error_map::ErrorStats;
@@ -123,6 +125,8 @@ pub struct EditorApp {
     /// The driver image: resolved path and what loading it gave (cached; reloaded when the path
     /// or the preset's folder changes).
     image: Option<(PathBuf, Result<Arc<ImageDriver>, String>)>,
+    /// The lighting's environment file: resolved path and its SH9 radiance (cached likewise).
+    environment: Option<(PathBuf, Result<Sh9, String>)>,
     saved: Material,
     recent: Vec<PathBuf>,
     view: ViewState,
@@ -211,6 +215,7 @@ impl EditorApp {
             material,
             path,
             image: None,
+            environment: None,
             saved,
             recent: stored.recent.clone(),
             view: stored.view.clone(),
@@ -322,9 +327,36 @@ impl EditorApp {
                     .and_then(|(_, r)| r.as_ref().ok().cloned())
             }
         };
+        let environment = match &self.material.lighting.environment {
+            Some(Environment {
+                source: EnvironmentSource::File { path },
+                ..
+            }) => {
+                let dir = self
+                    .path
+                    .as_ref()
+                    .and_then(|p| p.parent())
+                    .unwrap_or(Path::new("."));
+                let full = dir.join(path);
+                if self.environment.as_ref().is_none_or(|(p, _)| *p != full) {
+                    let r = preset_io::environment_file(&self.material, self.path.as_deref())
+                        .map_err(|e| e.to_string())
+                        .and_then(|i| i.ok_or_else(|| "no environment".to_owned()));
+                    if let Err(e) = &r {
+                        self.notify(ctx, e.clone(), true);
+                    }
+                    self.environment = Some((full, r));
+                }
+                self.environment
+                    .as_ref()
+                    .and_then(|(_, r)| r.as_ref().ok().copied())
+            }
+            _ => None,
+        };
         preset_io::Resolved {
             material: self.material.clone(),
             image,
+            environment,
         }
     }
 
@@ -685,11 +717,12 @@ impl EditorApp {
             return;
         }
         self.generation += 1;
-        let image = self.resolved(ctx).image;
+        let resolved = self.resolved(ctx);
         let req = Request {
             generation: self.generation,
             material: Arc::new(self.material.clone()),
-            image,
+            image: resolved.image,
+            environment: resolved.environment,
             scene,
             size: self.view_px,
             modes,

@@ -14,6 +14,7 @@
 
 use lodestone_core::footprint::Prepared;
 use lodestone_core::image_driver::ImageDriver;
+use lodestone_core::sh::Sh9;
 use lodestone_core::material::Material;
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
@@ -31,6 +32,8 @@ pub struct Request {
     pub material: Arc<Material>,
     /// Its driver image (image drivers only).
     pub image: Option<Arc<ImageDriver>>,
+    /// The SH9 radiance of its environment file (file environments only).
+    pub environment: Option<Sh9>,
     /// Camera and light.
     pub scene: Scene,
     /// Full size of one view in physical pixels.
@@ -187,6 +190,8 @@ struct State {
     material: Option<(Arc<Material>, GpuMaterial)>,
     /// The last prepared material (its tables are reused when their inputs did not change).
     prepared: Option<Prepared>,
+    /// The environment radiance the prepared material was given.
+    environment: Option<Sh9>,
     /// Seconds per pixel of each analytic mode, measured.
     cost: Vec<(ViewMode, f64)>,
     truth: Option<ViewTarget>,
@@ -198,6 +203,7 @@ impl State {
             renderer,
             material: None,
             prepared: None,
+            environment: None,
             cost: Vec::new(),
             truth: None,
         }
@@ -242,6 +248,7 @@ impl State {
         &mut self,
         material: &Arc<Material>,
         image: &Option<Arc<ImageDriver>>,
+        environment: &Option<Sh9>,
         send: &dyn Fn(Event),
     ) -> bool {
         let same_image = |p: &Prepared| match (p.surface.driver.image(), image) {
@@ -252,11 +259,16 @@ impl State {
         if let Some((m, _)) = &self.material
             && (Arc::ptr_eq(m, material) || **m == **material)
             && self.prepared.as_ref().is_some_and(same_image)
+            && self.environment == *environment
         {
             return true;
         }
         match Prepared::with_image(material, image.clone(), self.prepared.as_ref()) {
-            Ok(p) => {
+            Ok(mut p) => {
+                if let Some(sh) = environment {
+                    p.set_environment_radiance(sh);
+                }
+                self.environment = *environment;
                 let gm = GpuMaterial::new(self.renderer.context(), &p, [0.0, 0.0]);
                 self.material = Some((material.clone(), gm));
                 self.prepared = Some(p);
@@ -311,7 +323,7 @@ impl State {
         rx: &Receiver<Request>,
         send: &dyn Fn(Event),
     ) -> Result<Option<Request>, ()> {
-        if !self.upload(&req.material, &req.image, send) {
+        if !self.upload(&req.material, &req.image, &req.environment, send) {
             return Ok(None);
         }
         if let Some((_, gm)) = &self.material {
@@ -434,6 +446,7 @@ mod tests {
             generation,
             material: Arc::new(Material::default()),
             image: None,
+            environment: None,
             scene: Scene {
                 camera: Camera::default(),
                 light: direction(0.5, 1.0),
