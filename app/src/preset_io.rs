@@ -3,11 +3,11 @@
 //! Saves are atomic: the text goes to a temporary file beside the target, is flushed to disk, then
 //! renamed over the target, so a crash mid-save never leaves a truncated preset.
 
-use lodestone_core::footprint::{PrepareError, Prepared};
 use lodestone_core::environment::{Environment, EnvironmentSource, EquirectMap};
+use lodestone_core::footprint::{PrepareError, Prepared};
 use lodestone_core::image_driver::ImageDriver;
-use lodestone_core::sh::Sh9;
 use lodestone_core::material::{Driver, Material, MaterialError};
+use lodestone_core::sh::Sh9;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

@@ -103,7 +103,8 @@ impl ColorTerms {
         match self.mode {
             CombineMode::Linear => {
                 let a = [0, 1, 2].map(|c| {
-                    c0.map_or(0.0, |t| t.weight * t.color[c]) + self.height.map_or(0.0, |w| w * ch[c])
+                    c0.map_or(0.0, |t| t.weight * t.color[c])
+                        + self.height.map_or(0.0, |w| w * ch[c])
                 });
                 Affine {
                     a,

@@ -133,7 +133,8 @@ impl Prepared {
         let (wo_l, wi_l) = (local(-dir, fr), local(wi, fr));
         // Shadow ray: to where it leaves the bounding cylinder.
         let sees = || {
-            intersect(r, outer, p, wi).is_none_or(|(_, e1)| self.cylinder_march(r, p, wi, e1).is_none())
+            intersect(r, outer, p, wi)
+                .is_none_or(|(_, e1)| self.cylinder_march(r, p, wi, e1).is_none())
         };
         let m = DMat3::from_cols(fr.0, fr.1, fr.2);
         self.shade_hit(f, n, wo_l, wi_l, &m, sees)

@@ -175,7 +175,11 @@ impl EquirectMap {
             let dw = (t0.cos() - t1.cos()) * (2.0 * PI / self.width as f64);
             for x in 0..self.width {
                 let phi = 2.0 * PI * (x as f64 + 0.5) / self.width as f64;
-                let d = DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+                let d = DVec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                );
                 let b = crate::sh::sh_basis(d);
                 let t = self.texels[y * self.width + x];
                 for k in 0..9 {
@@ -280,7 +284,11 @@ mod tests {
             let theta = std::f64::consts::PI * (y as f64 + 0.5) / h as f64;
             for x in 0..w {
                 let phi = std::f64::consts::TAU * (x as f64 + 0.5) / w as f64;
-                let d = DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+                let d = DVec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                );
                 texels.push(sky.radiance(d).map(|v| v as f32));
             }
         }
@@ -302,8 +310,14 @@ mod tests {
 
     #[test]
     fn bad_maps_are_refused() {
-        assert_eq!(EquirectMap::new(1, 1, vec![[0.0; 3]]), Err(EquirectError::Size));
-        assert_eq!(EquirectMap::new(2, 2, vec![[0.0; 3]; 3]), Err(EquirectError::Size));
+        assert_eq!(
+            EquirectMap::new(1, 1, vec![[0.0; 3]]),
+            Err(EquirectError::Size)
+        );
+        assert_eq!(
+            EquirectMap::new(2, 2, vec![[0.0; 3]; 3]),
+            Err(EquirectError::Size)
+        );
         let mut t = vec![[0.5; 3]; 8];
         t[5][1] = f32::NAN;
         assert_eq!(

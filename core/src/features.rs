@@ -160,28 +160,27 @@ impl FeatureSet {
                 Feature::DriverColor,
                 colour_model
                     && matches!(
-                    m.color,
-                    ColorModel::Gradient {
-                        source: ColorSource::Driver,
-                        ..
-                    }
-                ),
+                        m.color,
+                        ColorModel::Gradient {
+                            source: ColorSource::Driver,
+                            ..
+                        }
+                    ),
             )
             .with(
                 Feature::HeightColor,
                 colour_model
                     && matches!(
-                    m.color,
-                    ColorModel::Gradient {
-                        source: ColorSource::Height,
-                        ..
-                    }
-                ),
+                        m.color,
+                        ColorModel::Gradient {
+                            source: ColorSource::Height,
+                            ..
+                        }
+                    ),
             )
             .with(
                 Feature::AttributeColor,
-                colour_model
-                    && matches!(m.color, ColorModel::Attribute { .. }),
+                colour_model && matches!(m.color, ColorModel::Attribute { .. }),
             )
             .with(
                 Feature::TransferCurve,

@@ -24,17 +24,17 @@
 use crate::attribute::{attribute_shape, mean_attribute_shape};
 use crate::brdf::{gaussian2, normal_of, slope_of};
 use crate::color_terms::Affine;
-use crate::environment::EquirectMap;
-use crate::sh::Sh9;
-use crate::slope_color::CompiledSlopeColor;
 use crate::driver_field::DriverField;
 use crate::effective_height::height_moments;
+use crate::environment::EquirectMap;
 use crate::image_driver::ImageDriver;
 use crate::material::{ColorModel, ColorSource, Material};
 use crate::noise::{FilteredDriver, Footprint};
 use crate::preconvolved::PreconvolvedTable;
 use crate::quadrature::gauss_hermite_normal;
+use crate::sh::Sh9;
 use crate::shadowing::MaskingShadowing;
+use crate::slope_color::CompiledSlopeColor;
 use crate::slopes::SlopeCov;
 use crate::special::{erf, norm_cdf, norm_pdf};
 use crate::surface::{Surface, Trace, march_heightfield};
@@ -179,11 +179,7 @@ impl Prepared {
             color_table,
             transfer_table,
             g_global: (g.mean, g.std.max(1e-12)),
-            slope_color: material
-                .terms
-                .slope
-                .as_ref()
-                .map(|t| t.color.compiled()),
+            slope_color: material.terms.slope.as_ref().map(|t| t.color.compiled()),
             environment,
         })
     }
@@ -212,7 +208,9 @@ impl Prepared {
 
     /// Environment irradiance at unit normal n (0 without an environment).
     fn environment_at(&self, n: DVec3) -> [f64; 3] {
-        self.environment.as_ref().map_or([0.0; 3], |e| e.irradiance(n))
+        self.environment
+            .as_ref()
+            .map_or([0.0; 3], |e| e.irradiance(n))
     }
 
     /// [`SlopeShading`] of one facet of unit normal n (in the local tangent frame, where ωi is;
@@ -813,9 +811,7 @@ pub fn slope_mean(
     let mut acc = [0.0; 3];
     for (xa, wa) in x.iter().zip(w) {
         for (xb, wb) in x.iter().zip(w) {
-            let v = q(normal_of(
-                mean + DVec2::new(l11 * xa, l21 * xa + l22 * xb),
-            ));
+            let v = q(normal_of(mean + DVec2::new(l11 * xa, l21 * xa + l22 * xb)));
             for c in 0..3 {
                 acc[c] += wa * wb * v[c];
             }
@@ -1111,14 +1107,14 @@ pub(crate) mod tests {
         for (name, m) in cases {
             let p = Prepared::new(&m).unwrap();
             for deg in [0.0_f64, 30.0, 60.0] {
-                let cfg = far(
-                    direction(deg.to_radians(), 0.3),
-                    direction(0.5, 2.0),
-                );
+                let cfg = far(direction(deg.to_radians(), 0.3), direction(0.5, 2.0));
                 let gt = p.ground_truth(&cfg, 60_000, 23);
                 let fi = p.filtered(&cfg);
                 let na = p.naive(&cfg);
-                eprintln!("{name} {deg}: fi {fi:.4?} na {na:.4?} gt {:.4?} ± {:.4?}", gt.mean, gt.std_error);
+                eprintln!(
+                    "{name} {deg}: fi {fi:.4?} na {na:.4?} gt {:.4?} ± {:.4?}",
+                    gt.mean, gt.std_error
+                );
                 for k in 0..3 {
                     let rel = (fi[k] - gt.mean[k]).abs() / gt.mean[k];
                     naive_off = naive_off.max((na[k] - gt.mean[k]).abs() / gt.mean[k]);
@@ -1133,7 +1129,10 @@ pub(crate) mod tests {
                 }
             }
         }
-        assert!(naive_off > 0.1, "naive should be visibly wrong somewhere: {naive_off}");
+        assert!(
+            naive_off > 0.1,
+            "naive should be visibly wrong somewhere: {naive_off}"
+        );
     }
 
     #[test]

@@ -9,9 +9,9 @@
 
 use crate::brdf::BaseBrdf;
 use crate::color_terms::ColorTerms;
-use crate::environment::Lighting;
 use crate::colormap::Gradient;
 use crate::effective_height::HeightFilter;
+use crate::environment::Lighting;
 use crate::noise::{NoiseParams, SumOfSines};
 use crate::preconvolved::TableSpec;
 use crate::shadowing::Correlation;

@@ -61,12 +61,19 @@ impl Sh9 {
         let cols = 2 * rows;
         let mut c = [[0.0; 3]; 9];
         for i in 0..rows {
-            let (t0, t1) = (PI * i as f64 / rows as f64, PI * (i + 1) as f64 / rows as f64);
+            let (t0, t1) = (
+                PI * i as f64 / rows as f64,
+                PI * (i + 1) as f64 / rows as f64,
+            );
             let theta = 0.5 * (t0 + t1);
             let d_omega = (t0.cos() - t1.cos()) * (2.0 * PI / cols as f64);
             for j in 0..cols {
                 let phi = 2.0 * PI * (j as f64 + 0.5) / cols as f64;
-                let d = DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+                let d = DVec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                );
                 let radiance = l(d);
                 let y = sh_basis(d);
                 for k in 0..9 {
@@ -120,12 +127,19 @@ mod tests {
         let cols = 1200;
         let mut e = 0.0;
         for i in 0..rows {
-            let (t0, t1) = (PI * i as f64 / rows as f64, PI * (i + 1) as f64 / rows as f64);
+            let (t0, t1) = (
+                PI * i as f64 / rows as f64,
+                PI * (i + 1) as f64 / rows as f64,
+            );
             let theta = 0.5 * (t0 + t1);
             let dw = (t0.cos() - t1.cos()) * (2.0 * PI / cols as f64);
             for j in 0..cols {
                 let phi = 2.0 * PI * (j as f64 + 0.5) / cols as f64;
-                let d = DVec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+                let d = DVec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                );
                 e += l(d) * n.dot(d).max(0.0) * dw;
             }
         }
@@ -172,7 +186,10 @@ mod tests {
         ] {
             let want = brute_irradiance(n, l);
             let got = sh.irradiance(n)[0];
-            assert!((got - want).abs() < 1e-3 * want.abs().max(1.0), "n {n:?}: {got} vs {want}");
+            assert!(
+                (got - want).abs() < 1e-3 * want.abs().max(1.0),
+                "n {n:?}: {got} vs {want}"
+            );
         }
     }
 
@@ -198,7 +215,11 @@ mod tests {
         let sh = Sh9::project(128, |d| [if d.dot(sun) > 0.999 { 1e6 } else { 0.0 }; 3]);
         for k in 0..200 {
             let t = k as f64 * 0.1;
-            let n = DVec3::new(t.cos() * (0.3 * t).sin(), t.sin() * (0.3 * t).sin(), (0.3 * t).cos());
+            let n = DVec3::new(
+                t.cos() * (0.3 * t).sin(),
+                t.sin() * (0.3 * t).sin(),
+                (0.3 * t).cos(),
+            );
             let e = sh.irradiance(n);
             assert!(e.iter().all(|v| v.is_finite() && *v >= 0.0), "{e:?}");
         }

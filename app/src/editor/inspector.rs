@@ -4,12 +4,15 @@
 use super::curve_editor::CurveEditor;
 use super::gradient_editor::GradientEditor;
 use egui::{Slider, Ui};
+use lodestone_core::color_terms::{CombineMode, ConstantTerm, SlopeTerm};
 use lodestone_core::colormap::Gradient;
 use lodestone_core::effective_height::HeightFilter;
+use lodestone_core::environment::{Environment, EnvironmentSource, Lighting, Sky};
 use lodestone_core::features::{Feature, FeatureSet};
 use lodestone_core::material::{ColorModel, ColorSource, Driver, Filtering, Material};
 use lodestone_core::noise::NoiseParams;
 use lodestone_core::shadowing::Correlation;
+use lodestone_core::slope_color::SlopeColor;
 
 /// UI state of the inspector.
 #[derive(Debug, Default)]
@@ -18,6 +21,8 @@ pub struct Inspector {
     pub gradient: GradientEditor,
     /// The transfer curve editor.
     pub curve: CurveEditor,
+    /// The slope colour map's editor.
+    pub slope_gradient: GradientEditor,
     /// σ_nx and σ_ny move together.
     pub isotropic_lock: bool,
     /// Skewness and excess kurtosis of the loaded image driver, if any (set by the editor).
@@ -145,9 +150,32 @@ impl Inspector {
                 }
                 });
             });
-        egui::CollapsingHeader::new("Colour")
-            .default_open(true)
-            .show(ui, |ui| changed |= self.color(ui, m));
+        let colour_model = m.terms.uses_height_term();
+        section(
+            "Colour",
+            colour_model,
+            "the colour model is not one of the terms",
+            last.map(|f| {
+                f.contains(Feature::DriverColor)
+                    || f.contains(Feature::HeightColor)
+                    || f.contains(Feature::AttributeColor)
+            }),
+        )
+        .show(ui, |ui| changed |= self.color(ui, m));
+        // Colour terms and Lighting open by themselves when the material gains a slope term or an
+        // environment (a preset that uses them was loaded, or the user added one), and close when
+        // it loses them; otherwise they keep what the user chose.
+        let follow = |name: &str, f: Feature| {
+            let now = features.contains(f);
+            let h = egui::CollapsingHeader::new(name).default_open(now);
+            match last {
+                Some(l) if l.contains(f) == now => h,
+                _ => h.open(Some(now)),
+            }
+        };
+        follow("Colour terms", Feature::SlopeColor).show(ui, |ui| changed |= self.terms(ui, m));
+        follow("Lighting", Feature::Environment)
+            .show(ui, |ui| changed |= lighting(ui, &mut m.lighting));
         egui::CollapsingHeader::new("Base BRDF")
             .default_open(true)
             .show(ui, |ui| {
@@ -280,6 +308,128 @@ impl Inspector {
         changed
     }
 
+    /// The colour terms C0, C_h, C_s, their weights and how they combine [HNPN14 Sec. 6].
+    fn terms(&mut self, ui: &mut Ui, m: &mut Material) -> bool {
+        let mut changed = false;
+        let t = &mut m.terms;
+        let mut mode = t.mode;
+        egui::ComboBox::from_label("Combination")
+            .selected_text(match mode {
+                CombineMode::Linear => "Linear",
+                CombineMode::Multiplicative => "Multiplicative",
+            })
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut mode, CombineMode::Linear, "Linear");
+                ui.selectable_value(&mut mode, CombineMode::Multiplicative, "Multiplicative");
+            })
+            .response
+            .on_hover_text("Linear: C = κ0·C0 + κ1·C_h + κ2·C_s; multiplicative: C = Π(1 − κ + κ·C) over the terms [HNPN14 Sec. 6]");
+        if mode != t.mode {
+            t.mode = mode;
+            changed = true;
+        }
+        // Constant C0.
+        let mut on = t.constant.is_some();
+        if ui
+            .checkbox(&mut on, "Constant term C0")
+            .on_hover_text("Add or remove κ0·C0, a constant colour [HNPN14 Sec. 6]")
+            .changed()
+        {
+            t.constant = on.then_some(ConstantTerm {
+                color: [0.5; 3],
+                weight: 1.0,
+            });
+            changed = true;
+        }
+        if let Some(c) = &mut t.constant {
+            ui.horizontal(|ui| {
+                let l = ui.label("C0");
+                let mut rgb = c.color.map(|v| v.clamp(0.0, 1.0) as f32);
+                if ui
+                    .color_edit_button_rgb(&mut rgb)
+                    .labelled_by(l.id)
+                    .on_hover_text("C0: the constant colour (linear RGB)")
+                    .changed()
+                {
+                    c.color = rgb.map(f64::from);
+                    changed = true;
+                }
+            });
+            changed |= slider_f64(
+                ui,
+                &mut c.weight,
+                0.0..=1.0,
+                "κ0",
+                "κ0: weight of C0 [HNPN14 Sec. 6]",
+                false,
+            );
+        }
+        // Height / driver colour model C_h.
+        let mut on = t.height.is_some();
+        if ui
+            .checkbox(&mut on, "Colour model term C_h")
+            .on_hover_text("Add or remove κ1·C_h, the colour model of the Colour section (driver-, height- or attribute-correlated)")
+            .changed()
+        {
+            t.height = on.then_some(1.0);
+            changed = true;
+        }
+        if let Some(w) = &mut t.height {
+            changed |= slider_f64(
+                ui,
+                w,
+                0.0..=1.0,
+                "κ1",
+                "κ1: weight of the colour model C_h [HNPN14 Sec. 6]",
+                false,
+            );
+        }
+        // Slope colour C_s.
+        let mut on = t.slope.is_some();
+        if ui
+            .checkbox(&mut on, "Slope colour term C_s")
+            .on_hover_text("Add or remove κ2·C_s(n): a colour map of n·d, filtered over the visible slope distribution D_s [HNPN14 Sec. 5.2]")
+            .changed()
+        {
+            t.slope = on.then(|| SlopeTerm {
+                color: SlopeColor::snow(),
+                weight: 1.0,
+            });
+            changed = true;
+        }
+        if let Some(st) = &mut t.slope {
+            changed |= slider_f64(
+                ui,
+                &mut st.weight,
+                0.0..=1.0,
+                "κ2",
+                "κ2: weight of the slope colour C_s [HNPN14 Sec. 6]",
+                false,
+            );
+            changed |= slider_f64(
+                ui,
+                &mut st.color.elevation_deg,
+                -90.0..=90.0,
+                "Direction elevation",
+                "Elevation of d (degrees above the mean plane): the map's input is t = n·d; 90 = 'how level is the facet'",
+                false,
+            );
+            changed |= slider_f64(
+                ui,
+                &mut st.color.azimuth_deg,
+                -180.0..=180.0,
+                "Direction azimuth",
+                "Azimuth of d (degrees from +x toward +y): e.g. the side facets face for 'moss on north faces' [HNPN14 Fig. 9]",
+                false,
+            );
+            ui.label("C_s against t = n·d (−1 … 1)");
+            ui.push_id("slope colour map", |ui| {
+                changed |= self.slope_gradient.ui(ui, &mut st.color.map);
+            });
+        }
+        changed
+    }
+
     fn color(&mut self, ui: &mut Ui, m: &mut Material) -> bool {
         let mut changed = false;
         let is_gradient = matches!(m.color, ColorModel::Gradient { .. });
@@ -349,6 +499,105 @@ impl Inspector {
         }
         changed
     }
+}
+
+/// The directional light's strength and the environment [HNPN14 Sec. 5.3].
+fn lighting(ui: &mut Ui, l: &mut Lighting) -> bool {
+    let mut changed = false;
+    changed |= slider_f64(
+        ui,
+        &mut l.sun,
+        0.0..=4.0,
+        "Sun",
+        "Radiance scale of the directional light (its direction is the scene's light); 0 leaves only the environment",
+        false,
+    );
+    #[derive(PartialEq, Clone, Copy)]
+    enum Kind {
+        None,
+        Sky,
+        File,
+    }
+    let kind = match &l.environment {
+        None => Kind::None,
+        Some(Environment {
+            source: EnvironmentSource::Sky(_),
+            ..
+        }) => Kind::Sky,
+        Some(_) => Kind::File,
+    };
+    let mut want = kind;
+    egui::ComboBox::from_label("Environment")
+        .selected_text(match kind {
+            Kind::None => "None",
+            Kind::Sky => "Procedural sky",
+            Kind::File => "File (EXR/HDR)",
+        })
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut want, Kind::None, "None");
+            ui.selectable_value(&mut want, Kind::Sky, "Procedural sky");
+            ui.selectable_value(&mut want, Kind::File, "File (EXR/HDR)");
+        })
+        .response
+        .on_hover_text("An irradiance environment map (SH9, Ramamoorthi–Hanrahan 2001) treated as a slope colour map and filtered over D_s [HNPN14 Sec. 5.3]");
+    if want != kind {
+        let intensity = l.environment.as_ref().map_or(1.0, |e| e.intensity);
+        l.environment = match want {
+            Kind::None => None,
+            Kind::Sky => Some(Environment {
+                source: EnvironmentSource::Sky(Sky::default()),
+                intensity,
+            }),
+            Kind::File => Some(Environment {
+                source: EnvironmentSource::File {
+                    path: "environment.hdr".into(),
+                },
+                intensity,
+            }),
+        };
+        changed = true;
+    }
+    if let Some(env) = &mut l.environment {
+        changed |= slider_f64(
+            ui,
+            &mut env.intensity,
+            0.0..=4.0,
+            "Environment intensity",
+            "Multiplies the environment's radiance",
+            false,
+        );
+        match &mut env.source {
+            EnvironmentSource::Sky(sky) => {
+                changed |= slider_f64(
+                    ui,
+                    &mut sky.sun_elevation_deg,
+                    -10.0..=90.0,
+                    "Sky sun elevation",
+                    "Elevation of the sky's sun glow, degrees (independent of the directional light)",
+                    false,
+                );
+                changed |= slider_f64(
+                    ui,
+                    &mut sky.sun_azimuth_deg,
+                    -180.0..=180.0,
+                    "Sky sun azimuth",
+                    "Azimuth of the sky's sun glow, degrees from +x toward +y",
+                    false,
+                );
+            }
+            EnvironmentSource::File { path } => {
+                ui.horizontal(|ui| {
+                    let l = ui.label("File");
+                    changed |= ui
+                        .text_edit_singleline(path)
+                        .labelled_by(l.id)
+                        .on_hover_text("Equirectangular .exr or .hdr, relative to the preset's folder (top row = zenith)")
+                        .lost_focus();
+                });
+            }
+        }
+    }
+    changed
 }
 
 fn filtering(ui: &mut Ui, f: &mut Filtering) -> bool {

@@ -436,3 +436,39 @@ fn sections_that_do_nothing_collapse_and_come_back() {
     assert!(h.query_by_label_contains("Slopes (unused").is_none());
     h.get_by_role_and_label(egui::accesskit::Role::Slider, "σ_nx");
 }
+
+/// Colour terms: the slope term is added and removed with its checkbox (one undo step each), the
+/// colour model's section collapses when C_h leaves the terms, and the environment is chosen in
+/// the Lighting section.
+#[test]
+fn colour_terms_and_environment_are_edited_in_the_inspector() {
+    let mut h = harness(1600.0, 900.0, DeviceSource::Unavailable);
+    h.step();
+    let ctx = h.ctx.clone();
+    h.state_mut().open_path(&ctx, &preset("snake-skin.ron"));
+    h.step();
+    h.step();
+    assert!(h.state().material().terms.slope.is_some());
+    // The snake's sections are open: its slope term and sky are shown.
+    h.get_by_role_and_label(egui::accesskit::Role::Slider, "κ2");
+    h.get_by_role_and_label(egui::accesskit::Role::Slider, "Sky sun elevation");
+    h.get_by_label("Slope colour term C_s").click_accesskit();
+    h.step();
+    h.step();
+    assert!(h.state().material().terms.slope.is_none());
+    assert!(h.query_by_label("κ2").is_none());
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.step();
+    h.step();
+    assert!(
+        h.state().material().terms.slope.is_some(),
+        "undo brings the term back"
+    );
+    // Removing C_h collapses the colour model's section with the reason.
+    h.get_by_label("Colour model term C_h").click_accesskit();
+    h.step();
+    h.step();
+    h.step();
+    assert_eq!(h.state().material().terms.height, None);
+    h.get_by_label_contains("Colour (unused: the colour model is not one of the terms");
+}

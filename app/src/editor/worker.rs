@@ -14,8 +14,8 @@
 
 use lodestone_core::footprint::Prepared;
 use lodestone_core::image_driver::ImageDriver;
-use lodestone_core::sh::Sh9;
 use lodestone_core::material::Material;
+use lodestone_core::sh::Sh9;
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
 };
