@@ -12,7 +12,7 @@ use lodestone_core::cylinder::Shape;
 use lodestone_core::driver_field::{DriverField, TiledImage};
 use lodestone_core::effective_height::{EffectiveHeightTable, HeightFilter};
 use lodestone_core::features::{Feature, FeatureSet};
-use lodestone_core::footprint::{Prepared, hermite_rule};
+use lodestone_core::footprint::{Prepared, slope_rule};
 use lodestone_core::material::{ColorModel, ColorSource};
 use lodestone_core::piecewise::PiecewisePoly;
 use lodestone_core::preconvolved::PreconvolvedTable;
@@ -450,10 +450,9 @@ pub fn material_data_for(
         }
         mark(&data, start, "visible-height table D_h");
         let start = data.len();
-        let (x, w) = hermite_rule(points);
         lay.gh = data.len() as u32;
-        for (a, b) in x.iter().zip(w) {
-            data.extend([*a as f32, *b as f32]);
+        for (z, w) in slope_rule(points) {
+            data.extend([z.x as f32, z.y as f32, *w as f32]);
         }
         mark(&data, start, "slope quadrature rule");
     }

@@ -507,34 +507,35 @@ fn cholesky(c: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(l11, l21, sqrt(max(c.y - l21 * l21, 0.0)));
 }
 
-// Prepared::visible_shading: point_shading averaged on the weighted Gauss–Hermite nodes of D_s
-// (visible_slope_nodes), world slope space, slopes N(mean, cov).
+// Node i of footprint::slope_rule: (z.x, z.y, weight) of the standard bivariate normal.
+fn slope_node(i: u32) -> vec3<f32> {
+    let b = params.gh_offset + 3u * i;
+    return vec3<f32>(data[b], data[b + 1u], data[b + 2u]);
+}
+
+// Prepared::visible_shading: point_shading averaged on the nodes of D_s (visible_slope_nodes),
+// world slope space, slopes N(mean, cov).
 fn visible_shading(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> SlopeShading {
     let l = cholesky(cov);
-    let n = params.slope_points;
+    let nodes = params.slope_points * params.slope_points;
     var acc: SlopeShading;
     acc.cos = 0.0;
     acc.cs_cos = vec3<f32>(0.0);
     acc.env = vec3<f32>(0.0);
     acc.cs_env = vec3<f32>(0.0);
     var den = 0.0;
-    for (var a = 0u; a < n; a = a + 1u) {
-        let xa = data[params.gh_offset + 2u * a];
-        let wa = data[params.gh_offset + 2u * a + 1u];
-        for (var b = 0u; b < n; b = b + 1u) {
-            let xb = data[params.gh_offset + 2u * b];
-            let wb = data[params.gh_offset + 2u * b + 1u];
-            let s = mean + vec2<f32>(l.x * xa, l.y * xa + l.z * xb);
-            let u = max(wo.z - s.x * wo.x - s.y * wo.y, 0.0);
-            let wt = wa * wb * u;
-            if (wt > 0.0) {
-                let p = point_shading(normal_of(s), wi);
-                acc.cos = acc.cos + wt * p.cos;
-                acc.cs_cos = acc.cs_cos + wt * p.cs_cos;
-                acc.env = acc.env + wt * p.env;
-                acc.cs_env = acc.cs_env + wt * p.cs_env;
-                den = den + wt;
-            }
+    for (var i = 0u; i < nodes; i = i + 1u) {
+        let z = slope_node(i);
+        let s = mean + vec2<f32>(l.x * z.x, l.y * z.x + l.z * z.y);
+        let u = max(wo.z - s.x * wo.x - s.y * wo.y, 0.0);
+        let wt = z.z * u;
+        if (wt > 0.0) {
+            let p = point_shading(normal_of(s), wi);
+            acc.cos = acc.cos + wt * p.cos;
+            acc.cs_cos = acc.cs_cos + wt * p.cs_cos;
+            acc.env = acc.env + wt * p.env;
+            acc.cs_env = acc.cs_env + wt * p.cs_env;
+            den = den + wt;
         }
     }
     if (den > 0.0) {
@@ -551,17 +552,12 @@ fn visible_shading(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>
 // footprint::slope_mean of C_s: the footprint average without visibility weight.
 fn slope_color_mean(mean: vec2<f32>, cov: vec3<f32>) -> vec3<f32> {
     let l = cholesky(cov);
-    let n = params.slope_points;
+    let nodes = params.slope_points * params.slope_points;
     var acc = vec3<f32>(0.0);
-    for (var a = 0u; a < n; a = a + 1u) {
-        let xa = data[params.gh_offset + 2u * a];
-        let wa = data[params.gh_offset + 2u * a + 1u];
-        for (var b = 0u; b < n; b = b + 1u) {
-            let xb = data[params.gh_offset + 2u * b];
-            let wb = data[params.gh_offset + 2u * b + 1u];
-            let s = mean + vec2<f32>(l.x * xa, l.y * xa + l.z * xb);
-            acc = acc + (wa * wb) * slope_color_at(shading_frame * normal_of(s));
-        }
+    for (var i = 0u; i < nodes; i = i + 1u) {
+        let z = slope_node(i);
+        let s = mean + vec2<f32>(l.x * z.x, l.y * z.x + l.z * z.y);
+        acc = acc + z.z * slope_color_at(shading_frame * normal_of(s));
     }
     return acc;
 }
