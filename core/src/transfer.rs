@@ -298,6 +298,27 @@ fn poly_square(c: &[f64; NCOEF]) -> [f64; NCOEF] {
     out
 }
 
+/// Non-Gaussianity of a surface ([`TransferFunction::shape`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceShape {
+    /// Skewness of the heights.
+    pub skewness: f64,
+    /// Excess kurtosis of the heights.
+    pub excess_kurtosis: f64,
+    /// Excess kurtosis of each slope component.
+    pub slope_excess_kurtosis: f64,
+}
+
+impl SurfaceShape {
+    /// Whether the Gaussian approximation is likely to show (|skewness| > 0.5 or an excess
+    /// kurtosis beyond ±1, the editor's warning threshold for images too).
+    pub fn far_from_gaussian(&self) -> bool {
+        self.skewness.abs() > 0.5
+            || self.excess_kurtosis.abs() > 1.0
+            || self.slope_excess_kurtosis.abs() > 1.0
+    }
+}
+
 impl TransferFunction {
     /// g(f).
     pub fn eval(&self, f: f64) -> f64 {
@@ -340,6 +361,42 @@ impl TransferFunction {
                 // Quadratic g′ sampled at 65 points: pad for the maximum between samples.
                 best * 1.01
             }
+        }
+    }
+
+    /// How far from Gaussian the surface is under this transfer function, for f ~ N(0, 1): the
+    /// heights' skewness and excess kurtosis, and the slopes' excess kurtosis. Slopes are
+    /// `σ_h g′(f) ∇f` with ∇f Gaussian and independent of f (a stationary Gaussian field), so
+    /// each slope component has excess kurtosis `3(E[g′⁴]/E[g′²]² − 1)` (0 for the identity; a
+    /// curve with flats and steep risers has many near-zero slopes and a heavy tail). The
+    /// filtered model assumes Gaussian slopes for D_s [HNPN14 Sec. 8, Fig. 14]. Quadrature over
+    /// [−8, 8] (800 panels of 8-point Gauss–Legendre: curves are piecewise polynomial). A curve
+    /// whose g′ vanishes everywhere has no slopes: its slope kurtosis is reported as 0.
+    pub fn shape(&self) -> SurfaceShape {
+        let e = |q: &dyn Fn(f64) -> f64| {
+            crate::quadrature::integrate(|f| crate::special::norm_pdf(f) * q(f), -8.0, 8.0, 800)
+        };
+        let mean = e(&|f| self.eval(f));
+        let var = e(&|f| (self.eval(f) - mean).powi(2));
+        let (skewness, excess_kurtosis) = if var > 1e-300 {
+            (
+                e(&|f| (self.eval(f) - mean).powi(3)) / var.powf(1.5),
+                e(&|f| (self.eval(f) - mean).powi(4)) / (var * var) - 3.0,
+            )
+        } else {
+            (0.0, 0.0)
+        };
+        let d2 = e(&|f| self.derivative(f).powi(2));
+        let d4 = e(&|f| self.derivative(f).powi(4));
+        let slope_excess_kurtosis = if d2 > 1e-300 {
+            3.0 * (d4 / (d2 * d2) - 1.0)
+        } else {
+            0.0
+        };
+        SurfaceShape {
+            skewness,
+            excess_kurtosis,
+            slope_excess_kurtosis,
         }
     }
 
@@ -550,5 +607,36 @@ mod tests {
         }
         .validate("t", &mut p);
         assert_eq!(p.0.len(), 2);
+    }
+
+    #[test]
+    fn shape_of_identity_and_curves() {
+        let id = TransferFunction::Identity.shape();
+        assert!(
+            id.skewness.abs() < 1e-9 && id.excess_kurtosis.abs() < 1e-6,
+            "{id:?}"
+        );
+        assert!(id.slope_excess_kurtosis.abs() < 1e-9);
+        assert!(!id.far_from_gaussian());
+        // A curve with flats: slopes concentrate at 0 with a tail (positive slope kurtosis).
+        let moss = TransferFunction::Curve(Curve::moss()).shape();
+        assert!(moss.slope_excess_kurtosis > 1.0, "{moss:?}");
+        assert!(moss.far_from_gaussian());
+        // Brute force of the slope kurtosis by sampling f on a fine grid.
+        let t = TransferFunction::Curve(Curve::moss());
+        let (mut d2, mut d4, mut w) = (0.0, 0.0, 0.0);
+        for i in 0..200_000 {
+            let f = -8.0 + 16.0 * (i as f64 + 0.5) / 200_000.0;
+            let p = crate::special::norm_pdf(f);
+            let d = t.derivative(f);
+            d2 += p * d * d;
+            d4 += p * d.powi(4);
+            w += p;
+        }
+        let brute = 3.0 * ((d4 / w) / (d2 / w).powi(2) - 1.0);
+        assert!(
+            (brute - moss.slope_excess_kurtosis).abs() < 1e-3 * brute.abs(),
+            "{brute} vs {moss:?}"
+        );
     }
 }

@@ -12,6 +12,7 @@ use lodestone_core::features::{Feature, FeatureSet};
 use lodestone_core::material::{ColorModel, ColorSource, Driver, Filtering, Material};
 use lodestone_core::noise::NoiseParams;
 use lodestone_core::shadowing::Correlation;
+use lodestone_core::transfer::{SurfaceShape, TransferFunction};
 use lodestone_core::slope_color::SlopeColor;
 
 /// UI state of the inspector.
@@ -27,6 +28,8 @@ pub struct Inspector {
     pub isotropic_lock: bool,
     /// Skewness and excess kurtosis of the loaded image driver, if any (set by the editor).
     pub driver_shape: Option<(f64, f64)>,
+    /// The transfer curve's non-Gaussianity, cached with the curve it was computed for.
+    transfer_shape: Option<(TransferFunction, SurfaceShape)>,
     /// The material's features at the last frame: a section collapses when the feature it
     /// edits goes unused (and opens again when it comes back).
     last_features: Option<FeatureSet>,
@@ -114,6 +117,32 @@ impl Inspector {
                 );
                 ui.label("Height transfer function g [HNPN14 Sec. 7]");
                 changed |= self.curve.ui(ui, &mut m.heights.transfer);
+                if matches!(m.heights.transfer, TransferFunction::Curve(_)) {
+                    // Cached per curve: 800-panel quadratures are cheap but not per-frame cheap.
+                    if self.transfer_shape.as_ref().is_none_or(|(t, _)| *t != m.heights.transfer) {
+                        self.transfer_shape = Some((m.heights.transfer.clone(), m.heights.transfer.shape()));
+                    }
+                    if let Some((_, sh)) = &self.transfer_shape {
+                        ui.label(format!(
+                            "Through g: heights skewness {:.2}, excess kurtosis {:.2}; slopes excess kurtosis {:.2} (0 for a Gaussian)",
+                            sh.skewness, sh.excess_kurtosis, sh.slope_excess_kurtosis
+                        ));
+                        if sh.far_from_gaussian() {
+                            let slope_terms = m.terms.slope.is_some() || m.lighting.environment.is_some();
+                            ui.colored_label(
+                                ui.visuals().warn_fg_color,
+                                if slope_terms {
+                                    "Far from Gaussian: the slope colour and environment terms average over a Gaussian \
+                                     visible slope distribution [HNPN14 Sec. 8, Fig. 14]; a colour map with fine detail \
+                                     in slope will be off, most at grazing angles."
+                                } else {
+                                    "Far from Gaussian: the filtered view's masking and effective heights assume Gaussian \
+                                     statistics [HNPN14 Sec. 8]; expect larger errors at grazing angles."
+                                },
+                            );
+                        }
+                    }
+                }
             });
         section("Slopes", relief, "the surface is flat, sigma_h = 0", had_relief)
             .show(ui, |ui| {

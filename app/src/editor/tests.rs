@@ -472,3 +472,22 @@ fn colour_terms_and_environment_are_edited_in_the_inspector() {
     assert_eq!(h.state().material().terms.height, None);
     h.get_by_label_contains("Colour (unused: the colour model is not one of the terms");
 }
+
+/// A transfer curve's non-Gaussianity is shown under the curve, with a warning when it is far from
+/// Gaussian (moss: flats and steep clumps).
+#[test]
+fn transfer_curve_shape_and_warning_are_shown() {
+    let mut h = harness(1600.0, 900.0, DeviceSource::Unavailable);
+    h.step();
+    let ctx = h.ctx.clone();
+    h.state_mut().open_path(&ctx, &preset("moss.ron"));
+    h.step();
+    h.step();
+    h.get_by_label_contains("Through g: heights skewness");
+    h.get_by_label_contains("Far from Gaussian: the filtered view's masking");
+    // The identity has nothing to report.
+    h.state_mut().open_path(&ctx, &preset("default.ron"));
+    h.step();
+    h.step();
+    assert!(h.query_by_label_contains("Through g:").is_none());
+}
