@@ -1,7 +1,18 @@
 //! The `lodestone` binary: the editor and the headless command line.
 //!
 //! Exit codes: 0 success, 1 other failure, 2 bad input (unreadable or invalid preset),
-//! 3 no GPU adapter.
+//! 3 no GPU adapter. Output piped into a command that stops reading (`| head`) ends the program
+//! quietly with 0, like other command-line tools, instead of panicking.
+
+/// `print!` to stdout that exits quietly when the reader has gone (broken pipe).
+macro_rules! out {
+    ($($t:tt)*) => { $crate::write_stdout(format_args!($($t)*), false) };
+}
+
+/// `println!` to stdout that exits quietly when the reader has gone (broken pipe).
+macro_rules! outln {
+    ($($t:tt)*) => { $crate::write_stdout(format_args!($($t)*), true) };
+}
 
 mod chart;
 mod cli;
@@ -19,6 +30,21 @@ use cli::{Cli, Command};
 use lodestone_core::material::{Material, MaterialError};
 use std::path::Path;
 use std::process::ExitCode;
+
+/// Write to stdout; a closed pipe ends the process with 0, other errors are logged.
+fn write_stdout(args: std::fmt::Arguments<'_>, newline: bool) {
+    use std::io::Write;
+    let mut o = std::io::stdout().lock();
+    let r = o
+        .write_fmt(args)
+        .and_then(|()| if newline { o.write_all(b"\n") } else { Ok(()) });
+    if let Err(e) = r {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        log::error!("writing to stdout: {e}");
+    }
+}
 
 fn main() -> ExitCode {
     env_logger::Builder::from_env(
@@ -99,9 +125,9 @@ fn run(cli: Cli) -> Result<()> {
                 spp,
             )?;
             if json {
-                println!("{}", serde_json::to_string_pretty(&r)?);
+                outln!("{}", serde_json::to_string_pretty(&r)?);
             } else {
-                print!("{}", eval::table(&r));
+                out!("{}", eval::table(&r));
             }
         }
         Some(Command::Render {
@@ -134,7 +160,7 @@ fn run(cli: Cli) -> Result<()> {
         }
         Some(Command::Export { out }) => {
             let written = preset_io::export_bundle(&preset, &out)?;
-            println!(
+            outln!(
                 "wrote {} files to {} (see manifest.json)",
                 written.len(),
                 out.display()
@@ -165,13 +191,13 @@ fn run(cli: Cli) -> Result<()> {
             };
             let i = inspect::inspect(&preset, opts)?;
             if json {
-                println!("{}", serde_json::to_string_pretty(&i.to_json())?);
+                outln!("{}", serde_json::to_string_pretty(&i.to_json())?);
             } else {
-                print!("{}", i.to_text());
+                out!("{}", i.to_text());
             }
         }
-        Some(Command::Validate) => println!("ok: {} is a valid preset", material.name),
-        Some(Command::Show) => println!("{}", material.to_ron()),
+        Some(Command::Validate) => outln!("ok: {} is a valid preset", material.name),
+        Some(Command::Show) => outln!("{}", material.to_ron()),
         Some(Command::Stability { json }) => stability::run(json)?,
         Some(Command::Report {
             out,
@@ -190,15 +216,15 @@ fn run(cli: Cli) -> Result<()> {
             };
             let rep = report::run(&preset, &opts)?;
             report::write(&rep, &out)?;
-            print!("{}", report::markdown(&rep));
-            println!(
+            out!("{}", report::markdown(&rep));
+            outln!(
                 "wrote report.json, report.md, error_vs_time.svg, error_vs_view.svg to {}",
                 out.display()
             );
         }
         Some(Command::Adapter) => {
             let ctx = lodestone_render::GpuContext::new_headless()?;
-            println!("{}", ctx.describe());
+            outln!("{}", ctx.describe());
         }
     }
     Ok(())

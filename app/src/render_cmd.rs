@@ -106,9 +106,11 @@ pub fn render(
         RenderMode::Error => {
             let (f, t) = (draw(ViewMode::Filtered)?, draw(ViewMode::Truth)?);
             let s = error_stats(&f, &t);
-            println!(
+            outln!(
                 "filtered vs truth: RMSE {:.5}, max {:.5} (legend 0 … {:.5})",
-                s.rmse, s.max, s.max
+                s.rmse,
+                s.max,
+                s.max
             );
             save(&heat_map(&f, &t, s.max), out)?;
         }
@@ -127,7 +129,7 @@ pub fn render(
                 .fold(0.0, f64::max);
             for (name, img) in &modes {
                 let s = error_stats(img, &truth);
-                println!("{name:>16} vs truth: RMSE {:.5}, max {:.5}", s.rmse, s.max);
+                outln!("{name:>16} vs truth: RMSE {:.5}, max {:.5}", s.rmse, s.max);
                 save_as(img, out, name, formats)?;
                 save(
                     &heat_map(img, &truth, scale),
@@ -140,7 +142,7 @@ pub fn render(
                     )?;
                 }
             }
-            println!(
+            outln!(
                 "error maps share the legend 0 … {scale:.5} (linear RGB), truth {spp} rays/pixel"
             );
             save_as(&truth, out, "truth", formats)?;
@@ -228,16 +230,17 @@ pub fn bench(preset: &Resolved, size: (u32, u32), frames: u32, json: bool) -> Re
             "frame_ms": modes,
             "filtered_over_naive": ratio,
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        println!(
+        outln!(
             "{adapter}, {}×{}, median over {frames} batches of 8 frames (synchronised wall time)",
-            size.0, size.1
+            size.0,
+            size.1
         );
         for (n, ms) in &rows {
-            println!("{n:>22}: {ms:9.2} ms");
+            outln!("{n:>22}: {ms:9.2} ms");
         }
-        println!("{:>22}: {ratio:9.2}×", "filtered / naive");
+        outln!("{:>22}: {ratio:9.2}×", "filtered / naive");
     }
     Ok(())
 }

@@ -200,12 +200,12 @@ pub fn table(rows: &[Row]) -> String {
 pub fn run(json: bool) -> Result<()> {
     let rows = rows();
     if json {
-        println!("{}", serde_json::to_string_pretty(&rows)?);
+        outln!("{}", serde_json::to_string_pretty(&rows)?);
     } else {
-        print!("{}", table(&rows));
-        println!("reference and unit of each deviation:");
+        out!("{}", table(&rows));
+        outln!("reference and unit of each deviation:");
         for r in &rows {
-            println!("  {} [{}]: {}", r.case, r.path.name(), r.reference);
+            outln!("  {} [{}]: {}", r.case, r.path.name(), r.reference);
         }
     }
     let failed = rows.iter().filter(|r| !r.passed()).count();

@@ -12,8 +12,8 @@ use lodestone_core::features::{Feature, FeatureSet};
 use lodestone_core::material::{ColorModel, ColorSource, Driver, Filtering, Material};
 use lodestone_core::noise::NoiseParams;
 use lodestone_core::shadowing::Correlation;
-use lodestone_core::transfer::{SurfaceShape, TransferFunction};
 use lodestone_core::slope_color::SlopeColor;
+use lodestone_core::transfer::{SurfaceShape, TransferFunction};
 
 /// UI state of the inspector.
 #[derive(Debug, Default)]
