@@ -209,7 +209,15 @@ fn without_an_adapter_the_window_still_opens_and_says_why() {
 fn regenerate_app_screenshots() {
     let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("../screenshots/app");
     std::fs::create_dir_all(&out).expect("screenshots/app");
+    // LODESTONE_SHOTS=name,name regenerates only those.
+    let only = std::env::var("LODESTONE_SHOTS").ok();
     let shoot = |name: &str, setup: &dyn Fn(&mut Harness<'static, EditorApp>)| {
+        if only
+            .as_ref()
+            .is_some_and(|o| !o.split(',').any(|n| n == name))
+        {
+            return;
+        }
         let mut h = harness(1600.0, 900.0, DeviceSource::Headless);
         h.step();
         if no_adapter(&h) {
@@ -238,6 +246,18 @@ fn regenerate_app_screenshots() {
         let ctx = h.ctx.clone();
         h.state_mut().open_path(&ctx, &preset("moss.ron"));
         h.state_mut().view.camera.elevation_deg = 60.0;
+    });
+    shoot("snake-skin-colour-terms", &|h| {
+        let ctx = h.ctx.clone();
+        h.state_mut().open_path(&ctx, &preset("snake-skin.ron"));
+        h.state_mut().view.camera.elevation_deg = 70.0;
+        h.state_mut().view.camera.distance = 3.0;
+    });
+    shoot("snow-under-sky-grazing", &|h| {
+        let ctx = h.ctx.clone();
+        h.state_mut().open_path(&ctx, &preset("snow-under-sky.ron"));
+        h.state_mut().view.camera.elevation_deg = 78.0;
+        h.state_mut().view.camera.distance = 5.0;
     });
 }
 
