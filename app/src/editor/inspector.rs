@@ -622,6 +622,14 @@ fn lighting(ui: &mut Ui, l: &mut Lighting) -> bool {
                         .labelled_by(l.id)
                         .on_hover_text("Equirectangular .exr or .hdr, relative to the preset's folder (top row = zenith)")
                         .lost_focus();
+                    if ui.button("Browse…").clicked()
+                        && let Some(p) = rfd::FileDialog::new()
+                            .add_filter("Environment maps", &["exr", "hdr"])
+                            .pick_file()
+                    {
+                        *path = p.display().to_string();
+                        changed = true;
+                    }
                 });
             }
         }
