@@ -119,7 +119,13 @@ fn wgsl_material_rows(r: &Renderer) -> Vec<Row> {
                                 ViewMode::Filtered => Method::Filtered,
                                 ViewMode::Truth => continue,
                             };
-                            if *deg >= 89.9 {
+                            // Beyond truth_traceable the f32 march cannot place hits in the slab (a
+                            // 1e6-unit relief seen from 50 units); without an environment such
+                            // pixels are still comparable (the sun leaves them black on both
+                            // sides), with one they show the misplaced hit: finite only.
+                            if *deg >= 89.9
+                                || (p.environment.is_some() && !stability::truth_traceable(&p))
+                            {
                                 continue;
                             }
                             let c = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
@@ -156,7 +162,11 @@ fn wgsl_material_rows(r: &Renderer) -> Vec<Row> {
                 },
                 bound: 0.02,
                 non_finite: bad,
-                reference: "core's pixel (fraction of pixels off by > 0.5%)".into(),
+                reference: if compared > 0 {
+                    "core's pixel (fraction of pixels off by > 0.5%)".into()
+                } else {
+                    "finite and ≥ 0 only (f32 cannot place hits in this slab)".into()
+                },
             }
         })
         .collect()

@@ -128,23 +128,28 @@ impl ColorTerms {
         }
     }
 
-    /// Every invalid field.
+    /// Every invalid field. Weights are ≥ 0, and ≤ 1 when multiplicative (`1 − κ + κ·C` would go
+    /// negative beyond), so with colours ≥ 0 the combined colour is never negative.
     pub fn validate(&self, p: &mut Problems) {
         if self.constant.is_none() && self.height.is_none() && self.slope.is_none() {
             p.push("terms", "a material needs at least one colour term");
         }
+        let max_weight = match self.mode {
+            CombineMode::Linear => 1e3,
+            CombineMode::Multiplicative => 1.0,
+        };
         if let Some(c) = &self.constant {
             for i in 0..3 {
                 p.in_range(&format!("terms.constant.color[{i}]"), c.color[i], 0.0, 1e3);
             }
-            p.in_range("terms.constant.weight", c.weight, -1e3, 1e3);
+            p.in_range("terms.constant.weight", c.weight, 0.0, max_weight);
         }
         if let Some(w) = self.height {
-            p.in_range("terms.height", w, -1e3, 1e3);
+            p.in_range("terms.height", w, 0.0, max_weight);
         }
         if let Some(s) = &self.slope {
             s.color.validate("terms.slope.color", p);
-            p.in_range("terms.slope.weight", s.weight, -1e3, 1e3);
+            p.in_range("terms.slope.weight", s.weight, 0.0, max_weight);
         }
     }
 }
@@ -209,5 +214,14 @@ mod tests {
         }
         .validate(&mut p);
         assert_eq!(p.0.len(), 1, "no term at all is refused");
+        let mut t = terms(CombineMode::Multiplicative);
+        t.height = Some(2.0);
+        let mut p = Problems::default();
+        t.validate(&mut p);
+        assert_eq!(p.0.len(), 1, "a multiplicative weight above 1 is refused");
+        t.mode = CombineMode::Linear;
+        let mut p = Problems::default();
+        t.validate(&mut p);
+        assert!(p.0.is_empty(), "but not a linear one");
     }
 }

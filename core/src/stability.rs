@@ -6,14 +6,17 @@
 //! largest deviation stays within the row's documented bound. Deviations are relative with an absolute
 //! floor, `|got − ref| / max(|ref|, floor)`, so values that underflow (erfc(30) ≈ 2e-393) compare as 0.
 
+use crate::color_terms::{ColorTerms, CombineMode, ConstantTerm, SlopeTerm};
 use crate::colormap::{ColorStop, Gradient, Interpolation};
 use crate::effective_height::{EffectiveHeightTable, exact_moments};
+use crate::environment::{Environment, EnvironmentSource, Lighting, Sky};
 use crate::footprint::{Config, Method, Prepared};
 use crate::image_driver::ImageDriver;
 use crate::material::{ColorModel, ColorSource, Heights, Material, Slopes};
 use crate::noise::Footprint;
 use crate::preconvolved::TableSpec;
 use crate::quadrature::integrate;
+use crate::slope_color::SlopeColor;
 use crate::smith::direction;
 use crate::transfer::{Curve, TransferFunction};
 use crate::{special, special_f32};
@@ -378,6 +381,84 @@ pub fn material_cases() -> Vec<MaterialCase> {
         image: None,
         reference: None,
     });
+    // Slope colour and environment (issue 6): a constant slope map is the constant term exactly;
+    // a step slope map under the sky at extreme slope spreads stays finite.
+    let sky = Some(Environment {
+        source: EnvironmentSource::Sky(Sky::default()),
+        intensity: 1.0,
+    });
+    let slope_term = |map: Gradient, weight: f64| {
+        Some(SlopeTerm {
+            color: SlopeColor {
+                map,
+                elevation_deg: 60.0,
+                azimuth_deg: 30.0,
+            },
+            weight,
+        })
+    };
+    let single_stop = Gradient {
+        stops: vec![ColorStop {
+            position: 0.1,
+            color: [0.4, 0.3, 0.2],
+        }],
+        interpolation: Interpolation::Linear,
+    };
+    let lit = |m: Material| Material {
+        lighting: Lighting {
+            sun: 1.0,
+            environment: sky.clone(),
+        },
+        ..m
+    };
+    out.push(MaterialCase {
+        name: "constant slope colour under the sky".into(),
+        material: lit(Material {
+            terms: ColorTerms {
+                height: None,
+                slope: slope_term(single_stop, 1.0),
+                ..ColorTerms::default()
+            },
+            ..base()
+        }),
+        image: None,
+        reference: Some((
+            lit(Material {
+                terms: ColorTerms {
+                    height: None,
+                    constant: Some(ConstantTerm {
+                        color: [0.4, 0.3, 0.2],
+                        weight: 1.0,
+                    }),
+                    ..ColorTerms::default()
+                },
+                ..base()
+            }),
+            1e-6,
+            "the same colour as a constant term",
+        )),
+    });
+    for (sh, sn, mode, weight) in [
+        (1e-9, 1e-9, CombineMode::Multiplicative, 1.0),
+        (0.05, 1e6, CombineMode::Multiplicative, 1.0),
+        (1e6, 1e6, CombineMode::Linear, 1e3),
+    ] {
+        out.push(MaterialCase {
+            name: format!(
+                "step slope colour with the colour map ({mode:?}, κ = {weight:e}) under the sky, σ_h = {sh:e}, σ_n = {sn:e}"
+            ),
+            material: lit(Material {
+                terms: ColorTerms {
+                    mode,
+                    slope: slope_term(step_map(), weight),
+                    ..ColorTerms::default()
+                },
+                ..with_sigmas(sh, sn, sn)
+            }),
+            image: None,
+            reference: None,
+        });
+    }
     let image = Arc::new(ImageDriver::new(4, 4, &[0.7; 16]).expect("a constant image"));
     out.push(MaterialCase {
         name: "image driver of constant value".into(),
