@@ -998,7 +998,32 @@ impl EditorApp {
                 .collect()
         });
         if let Some(p) = dropped.into_iter().next() {
-            self.request_open(ctx, p);
+            let ext = p
+                .extension()
+                .map(|e| e.to_string_lossy().to_ascii_lowercase());
+            if matches!(ext.as_deref(), Some("exr" | "hdr")) {
+                // An environment map: the lighting's environment becomes that file (an undoable
+                // edit); relative to the preset's folder when it lies inside it.
+                let dir = self.path.as_ref().and_then(|p| p.parent());
+                let path = dir
+                    .and_then(|d| p.strip_prefix(d).ok())
+                    .unwrap_or(&p)
+                    .display()
+                    .to_string();
+                let intensity = self
+                    .material
+                    .lighting
+                    .environment
+                    .as_ref()
+                    .map_or(1.0, |e| e.intensity);
+                self.material.lighting.environment = Some(Environment {
+                    source: EnvironmentSource::File { path: path.clone() },
+                    intensity,
+                });
+                self.notify(ctx, format!("Environment: {path}"), false);
+            } else {
+                self.request_open(ctx, p);
+            }
         }
     }
 

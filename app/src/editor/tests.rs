@@ -250,8 +250,15 @@ fn regenerate_app_screenshots() {
     shoot("snake-skin-colour-terms", &|h| {
         let ctx = h.ctx.clone();
         h.state_mut().open_path(&ctx, &preset("snake-skin.ron"));
-        h.state_mut().view.camera.elevation_deg = 70.0;
+        h.state_mut().view.camera.elevation_deg = 65.0;
         h.state_mut().view.camera.distance = 3.0;
+        h.step();
+        h.step();
+        // Fold the driver, heights and slopes so the colour terms and lighting are in view.
+        for header in ["Driver f", "Heights", "Slopes"] {
+            h.get_by_label(header).click_accesskit();
+            h.step();
+        }
     });
     shoot("snow-under-sky-grazing", &|h| {
         let ctx = h.ctx.clone();
@@ -510,4 +517,42 @@ fn transfer_curve_shape_and_warning_are_shown() {
     h.step();
     h.step();
     assert!(h.query_by_label_contains("Through g:").is_none());
+}
+
+/// Dropping an .hdr or .exr onto the window makes it the lighting's environment (one undo step);
+/// dropping a preset still opens it.
+#[test]
+fn dropping_an_environment_map_sets_the_environment() {
+    let mut h = harness(1200.0, 800.0, DeviceSource::Unavailable);
+    h.step();
+    assert!(h.state().material().lighting.environment.is_none());
+    #[derive(Debug)]
+    struct Dropped(std::path::PathBuf);
+    impl egui::DroppedFile for Dropped {
+        fn path(&self) -> &std::path::Path {
+            &self.0
+        }
+        fn bytes(&self) -> Result<Vec<u8>, String> {
+            std::fs::read(&self.0).map_err(|e| e.to_string())
+        }
+    }
+    h.input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped("/tmp/studio.hdr".into())));
+    h.step();
+    h.step();
+    match &h.state().material().lighting.environment {
+        Some(lodestone_core::environment::Environment {
+            source: lodestone_core::environment::EnvironmentSource::File { path },
+            intensity,
+        }) => assert!(path.ends_with("studio.hdr") && *intensity == 1.0, "{path}"),
+        other => panic!("expected a file environment, got {other:?}"),
+    }
+    h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+    h.step();
+    h.step();
+    assert!(
+        h.state().material().lighting.environment.is_none(),
+        "undone"
+    );
 }
