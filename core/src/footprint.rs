@@ -1142,7 +1142,8 @@ pub(crate) mod tests {
     /// footprint, while naive is visibly off. Measured (n = 8): slope colour under a shadowing sun
     /// +1.7%, +2.0%, +3.9% (blue +4.7%) at 0°, 30°, 60°, of which the rule's part is ~0.8% (n = 32 gives +0.9%,
     /// +1.1%, +3.0%: the rest is the model's — V̄ shadows every facet alike, while the snow-covered
-    /// flats are shadowed less than the average facet); the environment alone ≤ 0.6%. And
+    /// flats are shadowed less than the average facet); the environment alone ≤ 0.6%; anisotropic
+    /// slopes (σ_nx = 4σ_ny) with a tilted slope colour and the sky ≤ 0.9%. And
     /// naive (colour and irradiance at the mean normal) is visibly off in at least one case.
     #[test]
     fn slope_colour_and_environment_filter_to_ground_truth() {
@@ -1176,6 +1177,26 @@ pub(crate) mod tests {
         });
         m.lighting.environment = Some(sky);
         cases.push(("height x slope colour, sun + sky", m));
+        // Anisotropic slopes (σ_nx = 4 σ_ny) under a colour facing azimuth 45°, elevation 50°.
+        let mut m = gaussian_material();
+        m.slopes = Slopes {
+            sigma_nx: 0.6,
+            sigma_ny: 0.15,
+        };
+        m.terms.height = Some(0.5);
+        m.terms.slope = Some(SlopeTerm {
+            color: SlopeColor {
+                elevation_deg: 50.0,
+                azimuth_deg: 45.0,
+                ..SlopeColor::snow()
+            },
+            weight: 0.5,
+        });
+        m.lighting.environment = Some(Environment {
+            source: EnvironmentSource::Sky(Sky::default()),
+            intensity: 0.5,
+        });
+        cases.push(("anisotropic slopes, tilted slope colour, sun + sky", m));
         // (naive's worst error over all cases, asserted at the end)
         let mut naive_off = 0.0_f64;
         for (name, m) in cases {
