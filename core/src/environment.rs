@@ -164,32 +164,12 @@ impl EquirectMap {
 
     /// Its SH9 projection: every texel weighted by its exact solid angle.
     pub fn sh(&self) -> Sh9 {
-        use std::f64::consts::PI;
-        let mut c = [[0.0; 3]; 9];
-        for y in 0..self.height {
-            let (t0, t1) = (
-                PI * y as f64 / self.height as f64,
-                PI * (y + 1) as f64 / self.height as f64,
-            );
-            let theta = 0.5 * (t0 + t1);
-            let dw = (t0.cos() - t1.cos()) * (2.0 * PI / self.width as f64);
-            for x in 0..self.width {
-                let phi = 2.0 * PI * (x as f64 + 0.5) / self.width as f64;
-                let d = DVec3::new(
-                    theta.sin() * phi.cos(),
-                    theta.sin() * phi.sin(),
-                    theta.cos(),
-                );
-                let b = crate::sh::sh_basis(d);
-                let t = self.texels[y * self.width + x];
-                for k in 0..9 {
-                    for ch in 0..3 {
-                        c[k][ch] += f64::from(t[ch]) * b[k] * dw;
-                    }
-                }
-            }
-        }
-        Sh9 { coeffs: c }
+        let mut sh = Sh9::default();
+        crate::sh::sphere_grid(self.height, self.width, |y, x, d, d_omega| {
+            let t = self.texels[y * self.width + x];
+            sh.add(t.map(f64::from), d, d_omega);
+        });
+        sh
     }
 }
 

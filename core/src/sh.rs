@@ -43,6 +43,29 @@ pub fn sh_basis(d: DVec3) -> [f64; 9] {
     ]
 }
 
+/// Visit the cells of a `rows × cols` grid in (θ from the zenith, φ from +x toward +y), the layout
+/// of an equirectangular image: `visit(row, col, centre direction, exact solid angle of the cell)`.
+/// The solid angles sum to 4π exactly.
+pub fn sphere_grid(rows: usize, cols: usize, mut visit: impl FnMut(usize, usize, DVec3, f64)) {
+    for i in 0..rows {
+        let (t0, t1) = (
+            PI * i as f64 / rows as f64,
+            PI * (i + 1) as f64 / rows as f64,
+        );
+        let theta = 0.5 * (t0 + t1);
+        let d_omega = (t0.cos() - t1.cos()) * (2.0 * PI / cols as f64);
+        for j in 0..cols {
+            let phi = 2.0 * PI * (j as f64 + 0.5) / cols as f64;
+            let d = DVec3::new(
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            );
+            visit(i, j, d, d_omega);
+        }
+    }
+}
+
 /// Band of each coefficient in [`sh_basis`] order.
 const BAND: [usize; 9] = [0, 1, 1, 1, 2, 2, 2, 2, 2];
 
@@ -58,32 +81,19 @@ impl Sh9 {
     /// per-row solid angles (`rows` ≥ 2). A grid of 256 rows resolves features down to about 1°.
     pub fn project(rows: usize, l: impl Fn(DVec3) -> [f64; 3]) -> Self {
         let rows = rows.max(2);
-        let cols = 2 * rows;
-        let mut c = [[0.0; 3]; 9];
-        for i in 0..rows {
-            let (t0, t1) = (
-                PI * i as f64 / rows as f64,
-                PI * (i + 1) as f64 / rows as f64,
-            );
-            let theta = 0.5 * (t0 + t1);
-            let d_omega = (t0.cos() - t1.cos()) * (2.0 * PI / cols as f64);
-            for j in 0..cols {
-                let phi = 2.0 * PI * (j as f64 + 0.5) / cols as f64;
-                let d = DVec3::new(
-                    theta.sin() * phi.cos(),
-                    theta.sin() * phi.sin(),
-                    theta.cos(),
-                );
-                let radiance = l(d);
-                let y = sh_basis(d);
-                for k in 0..9 {
-                    for ch in 0..3 {
-                        c[k][ch] += radiance[ch] * y[k] * d_omega;
-                    }
-                }
+        let mut sh = Self::default();
+        sphere_grid(rows, 2 * rows, |_, _, d, d_omega| sh.add(l(d), d, d_omega));
+        sh
+    }
+
+    /// Add radiance `l` arriving from direction `d` over solid angle `d_omega` to the projection.
+    pub fn add(&mut self, l: [f64; 3], d: DVec3, d_omega: f64) {
+        let y = sh_basis(d);
+        for k in 0..9 {
+            for ch in 0..3 {
+                self.coeffs[k][ch] += l[ch] * y[k] * d_omega;
             }
         }
-        Self { coeffs: c }
     }
 
     /// Every coefficient multiplied by `s`.
@@ -123,26 +133,8 @@ mod tests {
 
     /// `∫ l(ω) (n·ω)⁺ dω` by brute force on a fine (θ, φ) grid.
     fn brute_irradiance(n: DVec3, l: impl Fn(DVec3) -> f64) -> f64 {
-        let rows = 600;
-        let cols = 1200;
         let mut e = 0.0;
-        for i in 0..rows {
-            let (t0, t1) = (
-                PI * i as f64 / rows as f64,
-                PI * (i + 1) as f64 / rows as f64,
-            );
-            let theta = 0.5 * (t0 + t1);
-            let dw = (t0.cos() - t1.cos()) * (2.0 * PI / cols as f64);
-            for j in 0..cols {
-                let phi = 2.0 * PI * (j as f64 + 0.5) / cols as f64;
-                let d = DVec3::new(
-                    theta.sin() * phi.cos(),
-                    theta.sin() * phi.sin(),
-                    theta.cos(),
-                );
-                e += l(d) * n.dot(d).max(0.0) * dw;
-            }
-        }
+        sphere_grid(600, 1200, |_, _, d, dw| e += l(d) * n.dot(d).max(0.0) * dw);
         e
     }
 

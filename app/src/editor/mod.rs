@@ -117,6 +117,23 @@ enum Pending {
     New,
 }
 
+/// A file loaded once per resolved path: the cache's result when `full` is the cached path, else
+/// `load()` (stored). Returns the result and whether it was loaded just now.
+fn cached_load<T: Clone>(
+    cache: &mut Option<(PathBuf, Result<T, String>)>,
+    full: PathBuf,
+    load: impl FnOnce() -> Result<T, String>,
+) -> (Result<T, String>, bool) {
+    let fresh = cache.as_ref().is_none_or(|(p, _)| *p != full);
+    if fresh {
+        *cache = Some((full, load()));
+    }
+    let r = cache
+        .as_ref()
+        .map_or_else(|| Err("not loaded".to_owned()), |(_, r)| r.clone());
+    (r, fresh)
+}
+
 /// The editor application.
 pub struct EditorApp {
     material: Material,
@@ -300,56 +317,39 @@ impl EditorApp {
         self.recent.truncate(MAX_RECENT);
     }
 
-    /// The material with its driver image, loaded relative to the preset's folder (the current
-    /// directory for an unsaved material). A load failure is reported once per path and leaves the
-    /// image out (the views then show the material error).
+    /// The material with its driver image and environment file, loaded relative to the preset's
+    /// folder (the current directory for an unsaved material). A load failure is reported once per
+    /// path and leaves the file out (the views then show the material error, or no environment).
     fn resolved(&mut self, ctx: &egui::Context) -> preset_io::Resolved {
-        let image = match &self.material.driver {
+        let dir = self
+            .path
+            .as_ref()
+            .and_then(|p| p.parent())
+            .unwrap_or(Path::new("."))
+            .to_owned();
+        let (material, preset) = (self.material.clone(), self.path.clone());
+        let image = match &material.driver {
             Driver::Noise(_) => None,
             Driver::Image { path, .. } => {
-                let dir = self
-                    .path
-                    .as_ref()
-                    .and_then(|p| p.parent())
-                    .unwrap_or(Path::new("."));
-                let full = dir.join(path);
-                if self.image.as_ref().is_none_or(|(p, _)| *p != full) {
-                    let r = preset_io::driver_image(&self.material, self.path.as_deref())
+                let r = cached_load(&mut self.image, dir.join(path), || {
+                    preset_io::driver_image(&material, preset.as_deref())
                         .map_err(|e| e.to_string())
-                        .and_then(|i| i.ok_or_else(|| "no image".to_owned()));
-                    if let Err(e) = &r {
-                        self.notify(ctx, e.clone(), true);
-                    }
-                    self.image = Some((full, r));
-                }
-                self.image
-                    .as_ref()
-                    .and_then(|(_, r)| r.as_ref().ok().cloned())
+                        .and_then(|i| i.ok_or_else(|| "no image".to_owned()))
+                });
+                self.report_load(ctx, r)
             }
         };
-        let environment = match &self.material.lighting.environment {
+        let environment = match &material.lighting.environment {
             Some(Environment {
                 source: EnvironmentSource::File { path },
                 ..
             }) => {
-                let dir = self
-                    .path
-                    .as_ref()
-                    .and_then(|p| p.parent())
-                    .unwrap_or(Path::new("."));
-                let full = dir.join(path);
-                if self.environment.as_ref().is_none_or(|(p, _)| *p != full) {
-                    let r = preset_io::environment_file(&self.material, self.path.as_deref())
+                let r = cached_load(&mut self.environment, dir.join(path), || {
+                    preset_io::environment_file(&material, preset.as_deref())
                         .map_err(|e| e.to_string())
-                        .and_then(|i| i.ok_or_else(|| "no environment".to_owned()));
-                    if let Err(e) = &r {
-                        self.notify(ctx, e.clone(), true);
-                    }
-                    self.environment = Some((full, r));
-                }
-                self.environment
-                    .as_ref()
-                    .and_then(|(_, r)| r.as_ref().ok().copied())
+                        .and_then(|i| i.ok_or_else(|| "no environment".to_owned()))
+                });
+                self.report_load(ctx, r)
             }
             _ => None,
         };
@@ -357,6 +357,23 @@ impl EditorApp {
             material: self.material.clone(),
             image,
             environment,
+        }
+    }
+
+    /// The value of a [`cached_load`]; a fresh failure is reported (once: later calls hit the cache).
+    fn report_load<T: Clone>(
+        &mut self,
+        ctx: &egui::Context,
+        r: (Result<T, String>, bool),
+    ) -> Option<T> {
+        match r {
+            (Ok(v), _) => Some(v),
+            (Err(e), fresh) => {
+                if fresh {
+                    self.notify(ctx, e, true);
+                }
+                None
+            }
         }
     }
 
