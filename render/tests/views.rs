@@ -160,9 +160,7 @@ fn analytic_views_match_core_pixel_by_pixel() {
             ] {
                 let img = r.render(&gm, &scene, mode, (w, h), 1).expect("readback");
                 // Pixels whose f32 (GPU) and f64 (core) rays land on different sides of a silhouette or
-                // shadow edge of the level-of-detail relief legitimately differ; allow 2.5% of them
-                // (the worst measured: snake-skin near, 24 of 1120, a cast-shadow band the f32
-                // march steps over, the known f32 LOD-march artefact; every other case ≤ 1%).
+                // shadow edge of the level-of-detail relief legitimately differ; allow 1% of them.
                 let mut off = vec![];
                 for y in 0..h {
                     for x in 0..w {
@@ -177,7 +175,7 @@ fn analytic_views_match_core_pixel_by_pixel() {
                         compared += 3;
                     }
                 }
-                let allowed = (w * h) as usize / 40;
+                let allowed = (w * h) as usize / 100;
                 assert!(
                     off.len() <= allowed,
                     "{name} {cam_name} {mode:?}: {} of {} pixels differ, e.g. {:?}",
@@ -267,32 +265,58 @@ fn cylinder_views_match_core_for(r: &Renderer, name: &str) {
         sky > 50 && sky < (w * h) as usize,
         "the cylinder and the sky are both in view: {sky}"
     );
-    // Ground truth: the GPU averages 16 Gaussian-jittered rays per pixel, core traces each pixel's
-    // centre ray; over the image both estimate the same mean radiance of the same geometry.
+    // Ground truth: the GPU averages 16 Gaussian-jittered rays per pixel (its pixel filter), core
+    // traces 16 rays per pixel through the same filter (a 4×4 stratified grid mapped by
+    // Box–Muller); over the image both estimate the same filtered radiance of the same geometry
+    // (glints and the snake's thin red flanks make one ray per pixel too noisy to compare).
     let img = r
         .render(&gm, &scene, ViewMode::Truth, (w, h), 16)
         .expect("readback");
+    let sigma = lodestone_core::camera::PIXEL_SIGMA;
+    let jitter: Vec<DVec2> = (0..16)
+        .map(|k| {
+            let (u1, u2) = (
+                (f64::from(k % 4) + 0.5) / 4.0,
+                (f64::from(k / 4) + 0.5) / 4.0,
+            );
+            let rad = (-2.0 * u1.ln()).sqrt() * sigma;
+            DVec2::new(
+                rad * (std::f64::consts::TAU * u2).cos(),
+                rad * (std::f64::consts::TAU * u2).sin(),
+            )
+        })
+        .collect();
     let mut gpu = [0.0f64; 3];
     let mut cpu = [0.0f64; 3];
     for y in 0..h {
         for x in 0..w {
             let g = img.rgb(x, y);
-            let c = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-            let ray = camera.ray(c, w, h);
-            let t = p.cylinder_trace_ray(radius, ray.origin, ray.dir, light);
             for k in 0..3 {
                 gpu[k] += f64::from(g[k]);
-                cpu[k] += t[k];
+            }
+            for j in &jitter {
+                let c = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5) + *j;
+                let ray = camera.ray(c, w, h);
+                let t = p.cylinder_trace_ray(radius, ray.origin, ray.dir, light);
+                for k in 0..3 {
+                    cpu[k] += t[k] / jitter.len() as f64;
+                }
             }
         }
     }
-    // Relative to the brightest channel: the snake's blue is a few percent of its red, and its
-    // silhouette pixels (lit by the sky, centre ray against 16 jittered rays) weigh on it.
+    // Relative to the brightest channel: the snake's blue is a few percent of its red.
     let top = cpu.iter().copied().fold(0.0, f64::max);
     for k in 0..3 {
         let rel = (gpu[k] - cpu[k]).abs() / top;
+        eprintln!(
+            "{name} channel {k}: GPU {} CPU {} ({:.2}% of the top channel)",
+            gpu[k],
+            cpu[k],
+            100.0 * rel
+        );
+        // Measured: ≤ 0.6% (default), ≤ 1.6% (snake-skin).
         assert!(
-            rel < 0.05,
+            rel < 0.03,
             "{name} channel {k}: GPU {} vs CPU {}",
             gpu[k],
             cpu[k]

@@ -189,6 +189,23 @@ fn wave(i: u32) -> vec4<f32> {
 }
 //#endif
 
+// UNROLL. llvmpipe (Mesa's CPU driver, what tests and CI run on) ends every loop of a shader
+// invocation once all loops together have taken 65535 back-edges (LP_MAX_TGSI_LOOP_ITERATIONS,
+// "shared between every loop", per 8-lane vector). A grazing march of a few thousand steps over
+// 48 waves used to reach it; every later wave sum was then cut short for all 8 lanes: the "dashes"
+// of wrong pixels in runs of exactly 8 (355 of 100 000 pixels of snow-under-sky at 78°, for
+// example). The wave sums that run per march step take eight waves per iteration, which moves the
+// limit 8× further; real GPUs have no such limit.
+
+//#if noise
+// Wave i's (value, gradient) at x.
+fn wave_term(i: u32, x: vec2<f32>) -> vec3<f32> {
+    let w = wave(i);
+    let ph = TAU * dot(w.xy, x) + w.w;
+    return vec3<f32>(w.z * cos(ph), -w.xy * (w.z * TAU * sin(ph)));
+}
+//#endif
+
 // DriverField::value_and_gradient: (f, ∂f/∂x, ∂f/∂y) of the noise (SumOfSines) or the image.
 fn value_and_gradient(x: vec2<f32>) -> vec3<f32> {
 //#if image
@@ -198,15 +215,18 @@ fn value_and_gradient(x: vec2<f32>) -> vec3<f32> {
     }
 //#endif
 //#if noise
-    var v = 0.0;
-    var g = vec2<f32>(0.0);
-    for (var i = 0u; i < params.wave_count; i = i + 1u) {
-        let w = wave(i);
-        let ph = TAU * dot(w.xy, x) + w.w;
-        v = v + w.z * cos(ph);
-        g = g - w.xy * (w.z * TAU * sin(ph));
+    // Eight waves per iteration: see UNROLL.
+    var s = vec3<f32>(0.0);
+    let n8 = params.wave_count & ~7u;
+    var i = 0u;
+    for (; i < n8; i = i + 8u) {
+        s = s + wave_term(i, x) + wave_term(i + 1u, x) + wave_term(i + 2u, x) + wave_term(i + 3u, x)
+            + wave_term(i + 4u, x) + wave_term(i + 5u, x) + wave_term(i + 6u, x) + wave_term(i + 7u, x);
     }
-    return vec3<f32>(v, g);
+    for (; i < params.wave_count; i = i + 1u) {
+        s = s + wave_term(i, x);
+    }
+    return s;
 //#else
     return vec3<f32>(0.0);
 //#endif
@@ -975,6 +995,14 @@ fn lod_prepare(fp: vec3<f32>) -> f32 {
     return sqrt(max(v, 0.0));
 }
 
+//#if noise
+// Wave i's term of f̄(x).
+fn lod_term(i: u32, x: vec2<f32>) -> f32 {
+    let w = wave(i);
+    return w.z * lod_att[i] * cos(TAU * dot(w.xy, x) + w.w);
+}
+//#endif
+
 // f̄(x) with the cached attenuations.
 fn lod_mean(x: vec2<f32>) -> f32 {
 //#if image
@@ -984,9 +1012,15 @@ fn lod_mean(x: vec2<f32>) -> f32 {
 //#endif
     var m = 0.0;
 //#if noise
-    for (var i = 0u; i < params.wave_count; i = i + 1u) {
-        let w = wave(i);
-        m = m + w.z * lod_att[i] * cos(TAU * dot(w.xy, x) + w.w);
+    // Eight waves per iteration: see UNROLL.
+    let n8 = params.wave_count & ~7u;
+    var i = 0u;
+    for (; i < n8; i = i + 8u) {
+        m = m + lod_term(i, x) + lod_term(i + 1u, x) + lod_term(i + 2u, x) + lod_term(i + 3u, x)
+            + lod_term(i + 4u, x) + lod_term(i + 5u, x) + lod_term(i + 6u, x) + lod_term(i + 7u, x);
+    }
+    for (; i < params.wave_count; i = i + 1u) {
+        m = m + lod_term(i, x);
     }
 //#endif
     return m;
