@@ -1,4 +1,6 @@
-//! Count pixels where the GPU's naive view differs from core's (llvmpipe loop-limit check).
+//! Count the pixels where the GPU's naive view differs from core's evaluation of the same pixel, at a
+//! grazing camera (the check that found llvmpipe's shared loop limit, see material.wgsl UNROLL).
+//! Usage: `cargo run --release -p lodestone-render --example naive_vs_core [PRESET]`.
 use glam::DVec2;
 use lodestone_core::camera::Camera;
 use lodestone_core::cylinder::Shape;
