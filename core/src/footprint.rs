@@ -230,7 +230,7 @@ impl Prepared {
     }
 
     /// [`SlopeShading`] averaged over the visible slope distribution D_s(ωo) of slopes N(mean, Σ)
-    /// (world slope space) on the material's weighted Gauss–Hermite nodes ([`visible_slope_nodes`]):
+    /// (world slope space) on the material's weighted polar nodes ([`visible_slope_nodes`], [`slope_rule`]):
     /// C_s and the environment are averaged *jointly* with the clamped cosine, so no independence of
     /// colour and shading is assumed ([HNPN14 Sec. 5.2] assumes it; the joint average costs the same).
     fn visible_shading(

@@ -101,7 +101,8 @@ pub struct Filtering {
     pub height_filter: HeightFilter,
     /// Size and σ range of the pre-convolved tables.
     pub table: TableSpec,
-    /// Gauss–Hermite points per axis for averages over the visible slope distribution D_s
+    /// n of the polar rule ([`crate::footprint::slope_rule`]: n radii × n angles) for averages over
+    /// the visible slope distribution D_s
     /// (the GPU evaluates n² points per pixel).
     pub slope_points: u32,
 }
@@ -118,7 +119,7 @@ impl Default for Filtering {
 }
 
 impl Filtering {
-    /// Default Gauss–Hermite order per axis.
+    /// Default n (64 nodes).
     pub const DEFAULT_SLOPE_POINTS: u32 = 8;
     /// Largest accepted order.
     pub const MAX_SLOPE_POINTS: u32 = 32;

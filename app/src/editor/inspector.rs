@@ -667,7 +667,7 @@ fn filtering(ui: &mut Ui, f: &mut Filtering) -> bool {
     }
     changed |= ui
         .add(Slider::new(&mut f.slope_points, 1..=Filtering::MAX_SLOPE_POINTS).text("Slope points"))
-        .on_hover_text("Gauss–Hermite points per axis for averages over the visible slope distribution D_s (n² per pixel)")
+        .on_hover_text("n: radii × angles of the polar rule for averages over the visible slope distribution D_s (diffuse cosine, slope colour C_s, environment; n² nodes per pixel) [HNPN14 Sec. 5.2]")
         .changed();
     changed
 }
