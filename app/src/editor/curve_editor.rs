@@ -3,14 +3,21 @@
 //! the resulting heights h = g(f), f ~ N(0, 1) [HNPN14 Sec. 7].
 
 use egui::{Color32, Pos2, Rect, Role, Sense, Stroke, Ui, Vec2, WidgetInfo};
+use lodestone_core::image_driver::ImageDriver;
 use lodestone_core::transfer::{Curve, CurveInterpolation, TransferFunction};
+use std::sync::Arc;
 
 /// Persistent UI state (the selected point).
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub struct CurveEditor {
     /// Selected control point.
     pub selected: usize,
+    /// The height histogram, cached with the curve and image it was computed for.
+    histogram: Option<(TransferFunction, Option<usize>, Histogram)>,
 }
+
+/// A histogram: the range of g it covers and the probability per bin.
+type Histogram = (f64, f64, Vec<f64>);
 
 /// Driver range shown on the f axis.
 const F_RANGE: (f64, f64) = (-3.5, 3.5);
@@ -19,25 +26,67 @@ const BINS: usize = 48;
 
 /// Histogram of `g(f)`, f ~ N(0, 1): probability per bin over `[lo, hi]`, by quadrature of the
 /// Gaussian over a fine grid of f (exact up to the grid, no sampling noise).
-pub fn height_histogram(t: &TransferFunction, bins: usize) -> (f64, f64, Vec<f64>) {
+pub fn height_histogram(t: &TransferFunction, bins: usize) -> Histogram {
     const N: usize = 4000;
     let (a, b) = (-6.0f64, 6.0f64);
     let df = (b - a) / N as f64;
-    let vals: Vec<(f64, f64)> = (0..N)
-        .map(|i| {
-            let f = a + (i as f64 + 0.5) * df;
-            let w = (-0.5 * f * f).exp() / (2.0 * std::f64::consts::PI).sqrt() * df;
-            (t.eval(f), w)
-        })
-        .collect();
+    let samples = (0..N).map(|i| {
+        let f = a + (i as f64 + 0.5) * df;
+        (
+            f,
+            (-0.5 * f * f).exp() / (2.0 * std::f64::consts::PI).sqrt() * df,
+        )
+    });
+    weighted_histogram(t, samples, bins)
+}
+
+/// Histogram of `g(f)` over an image driver's standardized texels (what its explicit surface
+/// shows, not the Gaussian the filtered views assume): every texel of level 0 up to 2¹⁶ of them,
+/// evenly strided beyond, with equal weights.
+pub fn image_height_histogram(t: &TransferFunction, image: &ImageDriver, bins: usize) -> Histogram {
+    let Some(level) = image.levels.first() else {
+        return height_histogram(t, bins);
+    };
+    let n = level.value.len().max(1);
+    let stride = n.div_ceil(1 << 16).max(1);
+    let count = n.div_ceil(stride);
+    let samples = level
+        .value
+        .iter()
+        .step_by(stride)
+        .map(|v| (f64::from(v[0]), 1.0 / count as f64));
+    weighted_histogram(t, samples, bins)
+}
+
+/// Probability per bin of g(f) for weighted samples of f, over the 0.1%–99.9% quantiles of g.
+fn weighted_histogram(
+    t: &TransferFunction,
+    samples: impl Iterator<Item = (f64, f64)>,
+    bins: usize,
+) -> Histogram {
+    // g through its polynomial once (TransferFunction::eval builds it per call).
+    let vals: Vec<(f64, f64)> = match t {
+        TransferFunction::Identity => samples.collect(),
+        TransferFunction::Curve(c) => {
+            let p = c.moment_poly();
+            let mut o = [0.0; 4];
+            samples
+                .map(|(f, w)| {
+                    p.eval(f, &mut o);
+                    (o[0], w)
+                })
+                .collect()
+        }
+    };
     // Range: the 0.1% and 99.9% quantiles of g, so rare tails do not squash the histogram.
     let mut sorted = vals.clone();
     sorted.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let total: f64 = sorted.iter().map(|v| v.1).sum();
     let quantile = |q: f64| {
         let mut acc = 0.0;
         for (g, w) in &sorted {
             acc += w;
-            if acc >= q {
+            if acc >= q * total {
                 return *g;
             }
         }
@@ -58,8 +107,14 @@ pub fn height_histogram(t: &TransferFunction, bins: usize) -> (f64, f64, Vec<f64
 }
 
 impl CurveEditor {
-    /// Show the editor for `t`. Returns true when it changed.
-    pub fn ui(&mut self, ui: &mut Ui, t: &mut TransferFunction) -> bool {
+    /// Show the editor for `t`; `image` is the material's image driver, whose texels the height
+    /// histogram then shows. Returns true when it changed.
+    pub fn ui(
+        &mut self,
+        ui: &mut Ui,
+        t: &mut TransferFunction,
+        image: Option<&Arc<ImageDriver>>,
+    ) -> bool {
         let mut changed = false;
         ui.horizontal_wrapped(|ui| {
             let shapes: [(&str, &str, TransferFunction); 5] = [
@@ -258,9 +313,27 @@ impl CurveEditor {
         } else {
             ui.weak("Identity: pick a shape above to edit a curve.");
         }
-        // Height histogram.
-        let (lo, hi, hist) = height_histogram(t, BINS);
-        ui.label("Height histogram of g(f), f ~ N(0, 1)");
+        // Height histogram (cached per curve and image).
+        let key = image.map(|i| Arc::as_ptr(i) as usize);
+        if self
+            .histogram
+            .as_ref()
+            .is_none_or(|(tc, k, _)| tc != &*t || *k != key)
+        {
+            let h = match image {
+                Some(img) => image_height_histogram(t, img, BINS),
+                None => height_histogram(t, BINS),
+            };
+            self.histogram = Some((t.clone(), key, h));
+        }
+        let Some((_, _, (lo, hi, hist))) = self.histogram.clone() else {
+            return changed;
+        };
+        ui.label(if image.is_some() {
+            "Height histogram of g(f), f = the image's standardized texels"
+        } else {
+            "Height histogram of g(f), f ~ N(0, 1)"
+        });
         let (hrect, _) = ui.allocate_exact_size(Vec2::new(width, 60.0), Sense::hover());
         let painter = ui.painter_at(hrect);
         painter.rect_filled(hrect, 2.0, vis_bg(ui));
@@ -347,5 +420,24 @@ mod tests {
         sorted.sort_by(|a, b| b.total_cmp(a));
         let top4: f64 = sorted[..8].iter().sum();
         assert!(top4 > 0.6, "shelves should hold most of the mass: {top4}");
+    }
+
+    /// An image driver's histogram is its texels': a two-valued image (a quarter high, three
+    /// quarters low) puts exactly those masses in the two end bins, not a Gaussian's.
+    #[test]
+    fn image_histogram_counts_the_texels() {
+        let values: Vec<f32> = (0..64)
+            .map(|i| if i % 4 == 0 { 3.0 } else { 1.0 })
+            .collect();
+        let img = ImageDriver::new(8, 8, &values).unwrap();
+        let (lo, hi, h) = image_height_histogram(&TransferFunction::Identity, &img, 10);
+        assert!(lo < hi);
+        let total: f64 = h.iter().sum();
+        assert!((total - 1.0).abs() < 1e-12, "{total}");
+        assert!(
+            (h[0] - 0.75).abs() < 1e-12 && (h[9] - 0.25).abs() < 1e-12,
+            "{h:?}"
+        );
+        assert!(h[1..9].iter().all(|v| *v == 0.0), "{h:?}");
     }
 }

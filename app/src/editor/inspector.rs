@@ -9,11 +9,13 @@ use lodestone_core::colormap::Gradient;
 use lodestone_core::effective_height::HeightFilter;
 use lodestone_core::environment::{Environment, EnvironmentSource, Lighting, Sky};
 use lodestone_core::features::{Feature, FeatureSet};
+use lodestone_core::image_driver::ImageDriver;
 use lodestone_core::material::{ColorModel, ColorSource, Driver, Filtering, Material};
 use lodestone_core::noise::NoiseParams;
 use lodestone_core::shadowing::Correlation;
 use lodestone_core::slope_color::SlopeColor;
 use lodestone_core::transfer::{SurfaceShape, TransferFunction};
+use std::sync::Arc;
 
 /// UI state of the inspector.
 #[derive(Debug, Default)]
@@ -28,6 +30,8 @@ pub struct Inspector {
     pub isotropic_lock: bool,
     /// Skewness and excess kurtosis of the loaded image driver, if any (set by the editor).
     pub driver_shape: Option<(f64, f64)>,
+    /// The loaded image driver, if any (set by the editor): the height histogram shows its texels.
+    pub driver_image: Option<Arc<ImageDriver>>,
     /// The transfer curve's non-Gaussianity, cached with the curve it was computed for.
     transfer_shape: Option<(TransferFunction, SurfaceShape)>,
     /// The material's features at the last frame: a section collapses when the feature it
@@ -116,7 +120,8 @@ impl Inspector {
                     false,
                 );
                 ui.label("Height transfer function g [HNPN14 Sec. 7]");
-                changed |= self.curve.ui(ui, &mut m.heights.transfer);
+                let image = self.driver_image.clone();
+                changed |= self.curve.ui(ui, &mut m.heights.transfer, image.as_ref());
                 if matches!(m.heights.transfer, TransferFunction::Curve(_)) {
                     // Cached per curve: 800-panel quadratures are cheap but not per-frame cheap.
                     if self.transfer_shape.as_ref().is_none_or(|(t, _)| *t != m.heights.transfer) {

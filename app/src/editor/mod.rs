@@ -1136,12 +1136,15 @@ impl eframe::App for EditorApp {
                         // Loads the image when its path changed (cached otherwise).
                         let _ = self.resolved(&ctx);
                     }
-                    self.inspector.driver_shape = match (&self.material.driver, &self.image) {
-                        (Driver::Image { .. }, Some((_, Ok(img)))) => {
-                            Some((img.skewness, img.excess_kurtosis))
-                        }
+                    self.inspector.driver_image = match (&self.material.driver, &self.image) {
+                        (Driver::Image { .. }, Some((_, Ok(img)))) => Some(img.clone()),
                         _ => None,
                     };
+                    self.inspector.driver_shape = self
+                        .inspector
+                        .driver_image
+                        .as_ref()
+                        .map(|img| (img.skewness, img.excess_kurtosis));
                     if self.inspector.ui(ui, &mut self.material) {
                         ctx.request_repaint();
                     }

@@ -439,6 +439,8 @@ fn image_driver_histogram_shape_is_shown() {
         "{s} {k}"
     );
     h.get_by_label_contains("Histogram: skewness -0.27");
+    // The curve editor's height histogram is the image's, not g(N(0, 1)).
+    h.get_by_label_contains("f = the image's standardized texels");
 }
 
 #[test]
