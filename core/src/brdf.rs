@@ -84,13 +84,6 @@ impl BaseBrdf {
         let d = gaussian2(slope_of(h) - slope_of(n), cov);
         self.specular * d / (4.0 * h.z.powi(4) * wo.z)
     }
-
-    /// Full `ρ(n, ωo, ωi)·(n·ωi)⁺` for a facet of colour `color` (linear RGB).
-    pub fn shade(&self, color: [f64; 3], n: DVec3, wo: DVec3, wi: DVec3) -> [f64; 3] {
-        let d = self.diffuse(n, wi);
-        let s = self.specular_with(n, wo, wi, SlopeCov::default());
-        color.map(|c| c * d + s)
-    }
 }
 
 #[cfg(test)]

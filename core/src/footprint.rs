@@ -32,7 +32,6 @@ use crate::image_driver::ImageDriver;
 use crate::material::{ColorModel, ColorSource, Material};
 use crate::noise::{FilteredDriver, Footprint};
 use crate::preconvolved::PreconvolvedTable;
-use crate::quadrature::gauss_hermite_normal;
 use crate::sh::Sh9;
 use crate::shadowing::MaskingShadowing;
 use crate::slope_color::CompiledSlopeColor;
@@ -747,29 +746,6 @@ pub(crate) fn cholesky(xx: f64, xy: f64, yy: f64) -> (f64, f64, f64) {
     (l11, l21, (yy - l21 * l21).max(0.0).sqrt())
 }
 
-/// Gauss–Hermite rules for N(0, 1), cached per order (1..=32).
-pub fn hermite_rule(n: usize) -> &'static (Vec<f64>, Vec<f64>) {
-    use std::sync::OnceLock;
-    static RULES: [OnceLock<(Vec<f64>, Vec<f64>)>; 32] = [const { OnceLock::new() }; 32];
-    let n = n.clamp(1, 32);
-    RULES[n - 1].get_or_init(|| gauss_hermite_normal(n))
-}
-
-/// E over the visible slope distribution D_s ∝ N(s; s̄, Σ)·(ωo_z − s·ωo_xy)⁺ [HNPN14 Sec. 5.2] of
-/// q(n(s)), in world slope space, on [`slope_rule`] with n² nodes (the material's
-/// `filtering.slope_points`).
-pub fn visible_slope_mean(
-    mean: DVec2,
-    sigma: &SlopeCov,
-    wo: DVec3,
-    n: usize,
-    q: impl Fn(DVec3) -> f64,
-) -> f64 {
-    let mut num = 0.0;
-    let den = visible_slope_nodes(mean, sigma, wo, n, |n, w| num += w * q(n));
-    if den > 0.0 { num / den } else { 0.0 }
-}
-
 /// The quadrature rule over a standard bivariate normal used for every average over a footprint's
 /// slopes, with `n` radii × `n` angles (n² nodes, `filtering.slope_points` = n), cached per n:
 /// nodes `z` and weights summing to 1, so `E[q(s)] ≈ Σ w q(μ + L z)` for `s ~ N(μ, LLᵀ)`.
@@ -821,18 +797,28 @@ pub fn visible_slope_nodes(
     n: usize,
     mut visit: impl FnMut(DVec3, f64),
 ) -> f64 {
-    let (l11, l21, l22) = cholesky(sigma.xx, sigma.xy, sigma.yy);
     let mut den = 0.0;
-    for (z, w) in slope_rule(n) {
-        let s = mean + DVec2::new(l11 * z.x, l21 * z.x + l22 * z.y);
-        let u = (wo.z - s.x * wo.x - s.y * wo.y).max(0.0);
-        let wt = w * u;
+    for (s, w) in slope_nodes(mean, sigma, n) {
+        let wt = w * (wo.z - s.x * wo.x - s.y * wo.y).max(0.0);
         if wt > 0.0 {
             visit(normal_of(s), wt);
             den += wt;
         }
     }
     den
+}
+
+/// The nodes of [`slope_rule`] mapped onto slopes `s ~ N(mean, Σ)` (`s = mean + L z`, L the
+/// Cholesky factor of Σ), with their weights.
+pub(crate) fn slope_nodes(
+    mean: DVec2,
+    sigma: &SlopeCov,
+    n: usize,
+) -> impl Iterator<Item = (DVec2, f64)> {
+    let (l11, l21, l22) = cholesky(sigma.xx, sigma.xy, sigma.yy);
+    slope_rule(n)
+        .iter()
+        .map(move |(z, w)| (mean + DVec2::new(l11 * z.x, l21 * z.x + l22 * z.y), *w))
 }
 
 /// `E[q(n(s))]` over N(s̄, Σ) without any visibility weight ([`slope_rule`]): the footprint
@@ -843,12 +829,9 @@ pub fn slope_mean(
     n: usize,
     q: impl Fn(DVec3) -> [f64; 3],
 ) -> [f64; 3] {
-    let (l11, l21, l22) = cholesky(sigma.xx, sigma.xy, sigma.yy);
     let mut acc = [0.0; 3];
-    for (z, w) in slope_rule(n) {
-        let v = q(normal_of(
-            mean + DVec2::new(l11 * z.x, l21 * z.x + l22 * z.y),
-        ));
+    for (s, w) in slope_nodes(mean, sigma, n) {
+        let v = q(normal_of(s));
         for c in 0..3 {
             acc[c] += w * v[c];
         }

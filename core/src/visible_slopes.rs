@@ -56,7 +56,7 @@
 //! earlier n×n Gauss–Hermite product rule the weighted nodes needed n ≥ 16 at grazing (20% at 80°
 //! with n = 4 and 8); the polar rule is what made n = 4–8 enough.
 
-use crate::footprint::{cholesky, expected_positive_part, slope_rule};
+use crate::footprint::{expected_positive_part, slope_nodes};
 use crate::slopes::SlopeCov;
 use crate::special::erfcx;
 use glam::{DVec2, DVec3};
@@ -149,13 +149,7 @@ impl VisibleSlopes {
     /// `E[f(s)]` over `N(mean, cov)` on the polar rule [`slope_rule`] with n² nodes (n clamped to
     /// 1..=32; n = 1 is `f(mean)`). Error against n and against the exact D_s: see the module docs.
     pub fn average(&self, n: usize, f: impl Fn(DVec2) -> DVec3) -> DVec3 {
-        let (l11, l21, l22) = cholesky(self.cov.xx, self.cov.xy, self.cov.yy);
-        let mut sum = DVec3::ZERO;
-        for (z, w) in slope_rule(n) {
-            let s = self.mean + DVec2::new(l11 * z.x, l21 * z.x + l22 * z.y);
-            sum += f(s) * *w;
-        }
-        sum
+        slope_nodes(self.mean, &self.cov, n).fold(DVec3::ZERO, |sum, (s, w)| sum + f(s) * w)
     }
 }
 
@@ -306,7 +300,7 @@ mod tests {
                 .map(|n| rel(d.average(*n, snow)))
                 .collect();
             // For comparison: no Gaussian approximation, the same rule over N(μ, Σ) with each node
-            // weighted by its projected area (a − b·s)⁺ (what footprint::visible_slope_mean does).
+            // weighted by its projected area (a − b·s)⁺ (what footprint::visible_slope_nodes does).
             let all = VisibleSlopes {
                 mean: mu,
                 cov: sigma(),

@@ -321,43 +321,49 @@ impl EditorApp {
     /// folder (the current directory for an unsaved material). A load failure is reported once per
     /// path and leaves the file out (the views then show the material error, or no environment).
     fn resolved(&mut self, ctx: &egui::Context) -> preset_io::Resolved {
+        let (image, environment) = self.load_files(ctx);
+        preset_io::Resolved {
+            material: self.material.clone(),
+            image,
+            environment,
+        }
+    }
+
+    /// The driver image and environment radiance of [`EditorApp::resolved`], from the cache unless
+    /// a path changed (cheap enough for every frame: nothing is cloned but the `Arc`).
+    fn load_files(&mut self, ctx: &egui::Context) -> (Option<Arc<ImageDriver>>, Option<Sh9>) {
         let dir = self
             .path
             .as_ref()
             .and_then(|p| p.parent())
             .unwrap_or(Path::new("."))
             .to_owned();
-        let (material, preset) = (self.material.clone(), self.path.clone());
+        let (material, preset) = (&self.material, self.path.as_deref());
         let image = match &material.driver {
             Driver::Noise(_) => None,
             Driver::Image { path, .. } => {
-                let r = cached_load(&mut self.image, dir.join(path), || {
-                    preset_io::driver_image(&material, preset.as_deref())
+                Some(cached_load(&mut self.image, dir.join(path), || {
+                    preset_io::driver_image(material, preset)
                         .map_err(|e| e.to_string())
                         .and_then(|i| i.ok_or_else(|| "no image".to_owned()))
-                });
-                self.report_load(ctx, r)
+                }))
             }
         };
         let environment = match &material.lighting.environment {
             Some(Environment {
                 source: EnvironmentSource::File { path },
                 ..
-            }) => {
-                let r = cached_load(&mut self.environment, dir.join(path), || {
-                    preset_io::environment_file(&material, preset.as_deref())
-                        .map_err(|e| e.to_string())
-                        .and_then(|i| i.ok_or_else(|| "no environment".to_owned()))
-                });
-                self.report_load(ctx, r)
-            }
+            }) => Some(cached_load(&mut self.environment, dir.join(path), || {
+                preset_io::environment_file(material, preset)
+                    .map_err(|e| e.to_string())
+                    .and_then(|i| i.ok_or_else(|| "no environment".to_owned()))
+            })),
             _ => None,
         };
-        preset_io::Resolved {
-            material: self.material.clone(),
-            image,
-            environment,
-        }
+        (
+            image.and_then(|r| self.report_load(ctx, r)),
+            environment.and_then(|r| self.report_load(ctx, r)),
+        )
     }
 
     /// The value of a [`cached_load`]; a fresh failure is reported (once: later calls hit the cache).
@@ -1134,7 +1140,7 @@ impl eframe::App for EditorApp {
                     ui.heading("Material");
                     if matches!(self.material.driver, Driver::Image { .. }) {
                         // Loads the image when its path changed (cached otherwise).
-                        let _ = self.resolved(&ctx);
+                        let _ = self.load_files(&ctx);
                     }
                     self.inspector.driver_image = match (&self.material.driver, &self.image) {
                         (Driver::Image { .. }, Some((_, Ok(img)))) => Some(img.clone()),

@@ -415,12 +415,6 @@ fn specular_with(n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, extra: vec3<f32>) -
 //#endif
 }
 
-// BaseBrdf::shade.
-fn shade(color: vec3<f32>, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
-    let d = params.albedo * FRAC_1_PI * max(dot(n, wi), 0.0);
-    let s = specular_with(n, wo, wi, vec3<f32>(0.0));
-    return color * d + vec3<f32>(s);
-}
 
 // ---------------------------------------------------------------- color_terms.rs, slope_color.rs, sh.rs
 // ColorTerms::affine: C = a + k ⊙ C_s for colour-model value ch (absent terms have weight 0, which
