@@ -193,11 +193,11 @@ pub enum ShapeArg {
 
 impl ShapeArg {
     /// The object, with `radius` for the cylinder (which must be positive and finite).
-    pub fn shape(self, radius: f64) -> Result<lodestone_core::cylinder::Shape, String> {
+    pub fn shape(self, radius: f64) -> Result<lodestone_core::scene::shape::Shape, String> {
         match self {
-            ShapeArg::Plane => Ok(lodestone_core::cylinder::Shape::Plane),
+            ShapeArg::Plane => Ok(lodestone_core::scene::shape::Shape::Plane),
             ShapeArg::Cylinder if radius > 0.0 && radius.is_finite() => {
-                Ok(lodestone_core::cylinder::Shape::Cylinder { radius })
+                Ok(lodestone_core::scene::shape::Shape::Cylinder { radius })
             }
             ShapeArg::Cylinder => Err(format!("--radius must be a positive number, got {radius}")),
         }

@@ -2,8 +2,8 @@
 
 use crate::preset_io::Resolved;
 use anyhow::Result;
-use lodestone_core::footprint::Config;
-use lodestone_core::smith::direction;
+use lodestone_core::eval::FootprintQuery;
+use lodestone_core::scene::direction::direction;
 use serde::Serialize;
 
 /// The result of `eval`, also its JSON form.
@@ -59,7 +59,7 @@ pub fn eval(preset: &Resolved, angles: [f64; 4], samples: usize) -> Result<EvalR
         light_deg.clamp(0.0, 90.0).to_radians(),
         light_azimuth_deg.to_radians(),
     );
-    let cfg = Config::far(&prepared, wo, wi);
+    let cfg = FootprintQuery::far(&prepared, wo, wi);
     let gt = prepared.ground_truth(&cfg, samples, 1);
     let (naive, vi, filtered) = (
         prepared.naive(&cfg),

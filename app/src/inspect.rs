@@ -8,7 +8,7 @@
 use crate::preset_io::Resolved;
 use crate::render_cmd::{View, frame_ms, renderer};
 use anyhow::Result;
-use lodestone_core::features::FeatureSet;
+use lodestone_core::material::features::FeatureSet;
 use lodestone_render::renderer::material_data_for;
 use lodestone_render::specialize::{ShaderSize, view_source_for};
 use lodestone_render::{GpuMaterial, ViewMode, ViewTarget};
@@ -246,9 +246,9 @@ impl Inspection {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lodestone_core::cylinder::Shape;
-    use lodestone_core::features::Feature;
     use lodestone_core::material::Material;
+    use lodestone_core::material::features::Feature;
+    use lodestone_core::scene::shape::Shape;
 
     fn view(light_deg: f64) -> View {
         View {

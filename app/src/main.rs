@@ -15,6 +15,7 @@ macro_rules! outln {
 }
 
 mod chart;
+mod cielab;
 mod cli;
 mod editor;
 mod eval;
@@ -23,6 +24,7 @@ mod preset_io;
 mod render_cmd;
 mod report;
 mod stability;
+mod stability_cases;
 
 use anyhow::{Context, Result};
 use clap::Parser;

@@ -3,11 +3,12 @@
 //! Saves are atomic: the text goes to a temporary file beside the target, is flushed to disk, then
 //! renamed over the target, so a crash mid-save never leaves a truncated preset.
 
-use lodestone_core::environment::{Environment, EnvironmentSource, EquirectMap};
-use lodestone_core::footprint::{PrepareError, Prepared};
-use lodestone_core::image_driver::ImageDriver;
+use lodestone_core::driver::DriverError;
+use lodestone_core::driver::image::ImageDriver;
+use lodestone_core::eval::Evaluator;
+use lodestone_core::material::environment::{Environment, EnvironmentSource, EquirectMap};
 use lodestone_core::material::{Driver, Material, MaterialError};
-use lodestone_core::sh::Sh9;
+use lodestone_core::math::sh::Sh9;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -98,8 +99,8 @@ impl Resolved {
     }
 
     /// The material's tables and surface, ready for the CPU reference and the GPU.
-    pub fn prepare(&self) -> Result<Prepared, PrepareError> {
-        let mut p = Prepared::with_image(&self.material, self.image.clone(), None)?;
+    pub fn prepare(&self) -> Result<Evaluator, DriverError> {
+        let mut p = Evaluator::with_image(&self.material, self.image.clone(), None)?;
         if let Some(sh) = &self.environment {
             p.set_environment_radiance(sh);
         }

@@ -3,9 +3,9 @@
 use crate::cli::{Formats, RenderMode};
 use crate::preset_io::Resolved;
 use anyhow::{Context, Result, bail};
-use lodestone_core::camera::Camera;
-use lodestone_core::cylinder::Shape;
-use lodestone_core::smith::direction;
+use lodestone_core::scene::camera::Camera;
+use lodestone_core::scene::direction::direction;
+use lodestone_core::scene::shape::Shape;
 use lodestone_render::error_map::{abs_difference, error_stats, heat_map};
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,

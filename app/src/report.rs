@@ -14,15 +14,15 @@
 //!   timestamp queries are not used. On the software adapter they are CPU times.
 
 use crate::chart::{Chart, Series};
+use crate::cielab::delta_e76;
 use crate::preset_io::Resolved;
 use anyhow::{Context, Result};
 use glam::DVec3;
-use lodestone_core::camera::Camera;
-use lodestone_core::cielab::delta_e76;
-use lodestone_core::cylinder::Shape;
-use lodestone_core::effective_height::HeightFilter;
-use lodestone_core::shadowing::Correlation;
-use lodestone_core::smith::direction;
+use lodestone_core::microfacet::effective_height::HeightFilter;
+use lodestone_core::microfacet::masking_shadowing::Correlation;
+use lodestone_core::scene::camera::Camera;
+use lodestone_core::scene::direction::direction;
+use lodestone_core::scene::shape::Shape;
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
 };

@@ -1,5 +1,5 @@
 //! `lodestone stability`: core's stiff and extreme cases (f64 and the f32 mirror, see
-//! `lodestone_core::stability`) plus the same cases through the WGSL on the GPU adapter.
+//! [`crate::stability_cases`]) plus the same cases through the WGSL on the GPU adapter.
 //!
 //! WGSL rows: the special functions on the same arguments (bound 1e-5·(1 + x²) relative: WGSL lets
 //! `exp`/`log` be off by a few ULP more than Rust's), and every material case rendered far away
@@ -10,24 +10,24 @@
 //! 0.5% + 2e-4 (bound 2%: f32 against f64 rays may cross a shadow edge differently).
 //! `LODESTONE_STABILITY_DEBUG=1` prints every failing WGSL pixel.
 
+use crate::stability_cases::{
+    self as stability, Path, Row, SpecialFunction, deviation, material_cases, special_reference,
+};
 use anyhow::Result;
 use glam::DVec2;
-use lodestone_core::camera::Camera;
-use lodestone_core::cylinder::Shape;
-use lodestone_core::footprint::{Method, Prepared};
-use lodestone_core::noise::Footprint;
-use lodestone_core::smith::direction;
-use lodestone_core::stability::{
-    self, Path, Row, SPECIAL_FUNCTIONS, deviation, material_cases, special_inputs,
-    special_reference,
-};
+use lodestone_core::driver::footprint::Footprint;
+use lodestone_core::eval::{Evaluator, Method};
+use lodestone_core::scene::camera::Camera;
+use lodestone_core::scene::direction::direction;
+use lodestone_core::scene::shape::Shape;
 use lodestone_render::{GpuContext, GpuMaterial, Renderer, Scene, ViewMode, compute, shaders};
 
 fn wgsl_special_rows(ctx: &GpuContext) -> Vec<Row> {
-    SPECIAL_FUNCTIONS
+    SpecialFunction::ALL
         .iter()
-        .map(|name| {
-            let xs = special_inputs(name);
+        .map(|&function| {
+            let name = function.name();
+            let xs = function.inputs();
             let xf: Vec<f32> = xs.iter().map(|x| *x as f32).collect();
             let got = compute::eval_unary(ctx, shaders::SPECIAL, name, &xf);
             let (mut dev, mut bad) = (0.0f64, 0);
@@ -36,8 +36,8 @@ fn wgsl_special_rows(ctx: &GpuContext) -> Vec<Row> {
                 if !g.is_finite() {
                     bad += 1;
                 }
-                let r =
-                    special_reference(name, *x).clamp(-f64::from(f32::MAX), f64::from(f32::MAX));
+                let r = special_reference(function, *x)
+                    .clamp(-f64::from(f32::MAX), f64::from(f32::MAX));
                 let x2 = f64::from(*xs32).powi(2).min(1e6);
                 dev = dev.max(deviation(g, r, 1e-30) / (1.0 + x2));
             }
@@ -62,7 +62,7 @@ fn wgsl_material_rows(r: &Renderer) -> Vec<Row> {
     material_cases()
         .into_iter()
         .map(|case| {
-            let p = match Prepared::with_image(&case.material, case.image.clone(), None) {
+            let p = match Evaluator::with_image(&case.material, case.image.clone(), None) {
                 Ok(p) => p,
                 Err(e) => {
                     return Row {

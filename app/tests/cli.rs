@@ -279,7 +279,7 @@ fn inspect_reports_features_shader_size_data_and_timings() {
 /// same `eval` as the sky itself (both project to SH9); a missing file exits 2 naming it.
 #[test]
 fn environment_file_matches_the_procedural_sky_and_a_missing_one_exits_2() {
-    use lodestone_core::environment::Sky;
+    use lodestone_core::material::environment::Sky;
     let dir = std::env::temp_dir().join(format!("lodestone-cli-env-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let sky = Sky::default();

@@ -2,10 +2,10 @@
 //! Goal: under 2 ms each so edits stay live. Run with `cargo bench -p lodestone-core`.
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use lodestone_core::colormap::Gradient;
-use lodestone_core::effective_height::EffectiveHeightTable;
-use lodestone_core::preconvolved::TableSpec;
-use lodestone_core::transfer::{Curve, TransferFunction};
+use lodestone_core::material::colormap::Gradient;
+use lodestone_core::material::preconvolved::TableSpec;
+use lodestone_core::material::transfer::{Curve, TransferFunction};
+use lodestone_core::microfacet::effective_height::EffectiveHeightTable;
 use std::hint::black_box;
 
 fn tables(c: &mut Criterion) {

@@ -3,11 +3,11 @@
 //! `cargo run -p lodestone-core --example library -- NAME > presets/NAME.ron`
 //! for NAME in sponge, terraces, bumpy-specular, colormapped-noise, cobblestones.
 
-use lodestone_core::brdf::BaseBrdf;
-use lodestone_core::colormap::{ColorStop, Gradient, Interpolation};
+use lodestone_core::driver::noise::NoiseParams;
+use lodestone_core::material::colormap::{ColorStop, Gradient, Interpolation};
+use lodestone_core::material::transfer::{Curve, TransferFunction};
 use lodestone_core::material::{ColorModel, ColorSource, Driver, Heights, Material, Slopes};
-use lodestone_core::noise::NoiseParams;
-use lodestone_core::transfer::{Curve, TransferFunction};
+use lodestone_core::microfacet::brdf::BaseBrdf;
 
 fn preset(name: &str) -> Option<(&'static str, Material)> {
     let base = Material::default();

@@ -1,17 +1,18 @@
 //! Property tests: every public function stays finite (and in range) on every input the UI can
-//! produce, grazing angles and σ → 0 included (numerics.md).
+//! produce, grazing angles and σ → 0 included (docs/numerics.md).
 
 use glam::{DVec2, DVec3};
-use lodestone_core::attribute::mean_attribute_shape;
-use lodestone_core::effective_height::{HeightFilter, height_moments};
-use lodestone_core::footprint::{Config, Prepared};
+use lodestone_core::driver::footprint::Footprint;
+use lodestone_core::eval::{Evaluator, FootprintQuery};
+use lodestone_core::material::preconvolved::TableSpec;
 use lodestone_core::material::{Material, Slopes};
-use lodestone_core::noise::Footprint;
-use lodestone_core::preconvolved::TableSpec;
-use lodestone_core::shadowing::{Correlation, MaskingShadowing};
-use lodestone_core::slopes::SlopeCov;
-use lodestone_core::smith::{direction, lambda, visibility_dir};
-use lodestone_core::{special, special_f32};
+use lodestone_core::math::{special, special_f32};
+use lodestone_core::microfacet::attribute::mean_attribute_shape;
+use lodestone_core::microfacet::effective_height::{HeightFilter, height_moments};
+use lodestone_core::microfacet::masking_shadowing::{Correlation, MaskingShadowing};
+use lodestone_core::microfacet::slopes::SlopeCov;
+use lodestone_core::microfacet::smith::{lambda, visibility_dir};
+use lodestone_core::scene::direction::direction;
 use proptest::prelude::*;
 
 /// σ in [0, 1e6]: exact zeros, tiny, ordinary and huge values, log-uniformly.
@@ -109,8 +110,8 @@ proptest! {
         m.heights.sigma_h = sh;
         m.slopes = Slopes { sigma_nx: sx, sigma_ny: sy };
         m.filtering.table = TableSpec { size_m: 16, size_sigma: 16, sigma_max: 1.0 };
-        let p = Prepared::new(&m).unwrap();
-        let cfg = Config { wo: direction(to, po), wi: direction(ti, pi), x0: DVec2::new(0.3, -1.7), footprint: Footprint::isotropic(r) };
+        let p = Evaluator::new(&m).unwrap();
+        let cfg = FootprintQuery { wo: direction(to, po), wi: direction(ti, pi), x0: DVec2::new(0.3, -1.7), footprint: Footprint::isotropic(r) };
         for v in [p.naive(&cfg), p.view_independent(&cfg), p.filtered(&cfg)] {
             prop_assert!(v.iter().all(|c| c.is_finite() && *c >= 0.0), "{v:?}");
         }

@@ -4,9 +4,9 @@
 //! (parse errors with a 1-based line and column inside the text); every success must be a valid
 //! material whose tables build and whose far-patch evaluation is finite.
 
-use lodestone_core::footprint::{Config, Prepared};
+use lodestone_core::eval::{Evaluator, FootprintQuery};
 use lodestone_core::material::{Material, MaterialError};
-use lodestone_core::smith::direction;
+use lodestone_core::scene::direction::direction;
 
 /// A small deterministic generator (SplitMix64), so failures reproduce.
 struct Rng(u64);
@@ -150,8 +150,8 @@ fn twelve_thousand_mutated_presets_never_panic() {
                 );
                 // Huge but valid values (e.g. 1e5 components of detail) may make preparation
                 // slow; limit the check to what the editor would build.
-                if let Ok(p) = Prepared::new(&m) {
-                    let cfg = Config::far(&p, direction(1.0, 0.0), direction(0.5, 2.0));
+                if let Ok(p) = Evaluator::new(&m) {
+                    let cfg = FootprintQuery::far(&p, direction(1.0, 0.0), direction(0.5, 2.0));
                     for v in p.filtered(&cfg).into_iter().chain(p.naive(&cfg)) {
                         assert!(v.is_finite(), "non-finite result for mutation {i}:\n{text}");
                     }

@@ -2,11 +2,11 @@
 //! grazing camera (the check that found llvmpipe's shared loop limit, see material.wgsl UNROLL).
 //! Usage: `cargo run --release -p lodestone-render --example naive_vs_core [PRESET]`.
 use glam::DVec2;
-use lodestone_core::camera::Camera;
-use lodestone_core::cylinder::Shape;
-use lodestone_core::footprint::{Method, Prepared};
+use lodestone_core::eval::{Evaluator, Method};
 use lodestone_core::material::Material;
-use lodestone_core::smith::direction;
+use lodestone_core::scene::camera::Camera;
+use lodestone_core::scene::direction::direction;
+use lodestone_core::scene::shape::Shape;
 use lodestone_render::{GpuContext, GpuMaterial, Renderer, Scene, ViewMode};
 
 fn main() {
@@ -14,7 +14,7 @@ fn main() {
         .nth(1)
         .unwrap_or("presets/snow-under-sky.ron".into());
     let m = Material::from_ron(&std::fs::read_to_string(&preset).unwrap()).unwrap();
-    let p = Prepared::new(&m).unwrap();
+    let p = Evaluator::new(&m).unwrap();
     let r = Renderer::new(GpuContext::new_headless().unwrap());
     let camera = Camera {
         elevation_deg: 78.0,

@@ -1,7 +1,7 @@
 //! The error view: per-pixel |mode − ground truth| as a heat map with a legend bar, plus RMSE and max.
 
 use crate::renderer::LinearImage;
-use lodestone_core::colormap::Gradient;
+use lodestone_core::material::colormap::Gradient;
 
 /// Error statistics of one image against a reference (linear RGB).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -56,7 +56,7 @@ pub fn heat_gradient() -> Gradient {
         ],
         0.0,
         1.0,
-        lodestone_core::colormap::Interpolation::Linear,
+        lodestone_core::material::colormap::Interpolation::Linear,
     )
 }
 

@@ -5,7 +5,7 @@
 //! |---|---|
 //! | `lodestone_filtered.wgsl` | self-contained WGSL: the special functions and the material model (the renderer's own `special.wgsl` + `material.wgsl`, so it equals the renderer by construction) and an example compute entry point |
 //! | `lodestone_filtered.glsl` | the same, translated to GLSL 4.50 (compute) by naga |
-//! | `params.bin` | the WGSL `Params` struct (std430, little-endian) for binding 0; camera fields are zero |
+//! | `params.bin` | the material's WGSL `Params` struct (std430, little-endian) for binding 0 |
 //! | `data.bin` | the material's f32 data buffer (waves, tables, D_h, quadrature rule) for binding 1 |
 //! | `color_table.exr`, `transfer_table.exr`, `effective_height.exr` | the pre-convolved tables as images, for engines that prefer textures |
 //! | `manifest.json` | sizes, ranges and indexing of every table, every `Params` field by name, the API |
@@ -18,13 +18,13 @@
 //! (the environment term, if any, is unshadowed); `eval_naive` and `eval_view_independent` take the
 //! same arguments.
 
-use crate::gpu_types::{GpuParams, gpu_params_offsets};
+use crate::gpu_types::{GpuStruct, MaterialParams};
 use crate::renderer::material_data;
 use crate::shaders;
-use lodestone_core::effective_height::EffectiveHeightTable;
-use lodestone_core::features::FeatureSet;
-use lodestone_core::footprint::Prepared;
-use lodestone_core::preconvolved::PreconvolvedTable;
+use lodestone_core::eval::Evaluator;
+use lodestone_core::material::features::FeatureSet;
+use lodestone_core::material::preconvolved::PreconvolvedTable;
+use lodestone_core::microfacet::effective_height::EffectiveHeightTable;
 use serde_json::json;
 
 /// Why a bundle could not be made.
@@ -76,7 +76,7 @@ fn lodestone_filtered_main(@builtin(global_invocation_id) id: vec3<u32>) {
 
 /// The self-contained WGSL snippet.
 pub fn snippet_wgsl() -> String {
-    let material = [shaders::SPECIAL, shaders::MATERIAL, shaders::IMAGE_DRIVER].join("\n");
+    let material = [shaders::SPECIAL, shaders::material(), shaders::IMAGE_DRIVER].join("\n");
     // The bundle's data holds every table the material has, so the snippet is the all-features
     // shader (the engine then picks the material at run time, as Lodestone's own fallback does).
     let material = crate::specialize::specialize(&material, FeatureSet::all())
@@ -183,7 +183,7 @@ fn table_json(
 }
 
 /// Every file of the bundle, as (name, bytes).
-pub fn bundle(prepared: &Prepared) -> Result<Vec<(String, Vec<u8>)>, ExportError> {
+pub fn bundle(prepared: &Evaluator) -> Result<Vec<(String, Vec<u8>)>, ExportError> {
     let (data, params) = material_data(prepared, [0.0, 0.0]);
     let m = &prepared.material;
     let mut files: Vec<(String, Vec<u8>)> = vec![
@@ -200,7 +200,7 @@ pub fn bundle(prepared: &Prepared) -> Result<Vec<(String, Vec<u8>)>, ExportError
         ("material.ron".into(), m.to_ron().into_bytes()),
     ];
     let mut tables = serde_json::Map::new();
-    if let Some(t) = &prepared.color_table {
+    if let Some(t) = prepared.color.table() {
         files.push(("color_table.exr".into(), table_exr("color_table.exr", t)?));
         tables.insert(
             "color".into(),
@@ -212,7 +212,7 @@ pub fn bundle(prepared: &Prepared) -> Result<Vec<(String, Vec<u8>)>, ExportError
             ),
         );
     }
-    if let Some(t) = &prepared.transfer_table {
+    if let Some(t) = prepared.transfer.table() {
         files.push((
             "transfer_table.exr".into(),
             table_exr("transfer_table.exr", t)?,
@@ -270,7 +270,7 @@ pub fn bundle(prepared: &Prepared) -> Result<Vec<(String, Vec<u8>)>, ExportError
         );
     }
     let bytes = bytemuck::bytes_of(&params);
-    let fields: serde_json::Map<String, serde_json::Value> = gpu_params_offsets()
+    let fields: serde_json::Map<String, serde_json::Value> = MaterialParams::offsets()
         .into_iter()
         .map(|(name, off)| {
             let word =
@@ -294,7 +294,7 @@ pub fn bundle(prepared: &Prepared) -> Result<Vec<(String, Vec<u8>)>, ExportError
             "example_entry_point": ENTRY_POINT,
             "example_input_stride_floats": INPUT_STRIDE,
         },
-        "params_size_bytes": std::mem::size_of::<GpuParams>(),
+        "params_size_bytes": std::mem::size_of::<MaterialParams>(),
         "params": fields,
         "data_floats": data.len(),
         "tables": tables,

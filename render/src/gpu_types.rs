@@ -1,168 +1,245 @@
-//! Structs shared with WGSL, byte for byte. `tests/shaders.rs` checks every field offset against the
-//! layout naga computes for the WGSL declaration.
+//! Structs shared with WGSL, byte for byte, each written once: [`gpu_struct!`] declares the Rust
+//! struct and the WGSL declaration together from one field list, and `tests/shaders.rs` checks
+//! every field offset against the layout naga computes for the generated WGSL.
+//!
+//! The parameters are split by who changes them: [`MaterialParams`] (binding 0, `params` in WGSL)
+//! is fixed when a material is uploaded and is all the material functions read (the engine bundle
+//! ships exactly it); [`ViewParams`] (binding 3, `view`) is the camera, light and pass of one view
+//! and is written per frame.
+//!
+//! Layout rules (WGSL storage, std430): a `vec3<f32>` aligns to 16 bytes and is followed by a
+//! scalar; structs round up to 16 bytes. The Rust side is `#[repr(C)]` with `[f32; 3]` for vec3.
 
 use bytemuck::{Pod, Zeroable};
 
-/// Mirror of `struct Params` in `shaders/material.wgsl` (storage-buffer layout).
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
-#[allow(missing_docs)]
-pub struct GpuParams {
-    pub eye: [f32; 3],
-    pub tan_half_fov: f32,
-    pub right: [f32; 3],
-    pub aspect: f32,
-    pub up: [f32; 3],
-    pub pixel_sigma: f32,
-    pub forward: [f32; 3],
-    pub frame: u32,
-    pub light: [f32; 3],
-    pub mode: u32,
-    pub attr_mean: [f32; 3],
-    pub dh_ln_min: f32,
-    pub attr_corr: [f32; 3],
-    pub dh_ln_max: f32,
-    pub width: u32,
-    pub height: u32,
-    pub shape: u32,
-    pub wave_count: u32,
-    pub sigma_h: f32,
-    pub albedo: f32,
-    pub specular: f32,
-    pub roughness: f32,
-    pub h_max: f32,
-    pub g_lip: f32,
-    pub min_step: f32,
-    pub transfer_kind: u32,
-    pub color_kind: u32,
-    pub correlation: u32,
-    pub height_filter: u32,
-    pub slope_points: u32,
-    pub g_mean: f32,
-    pub g_std: f32,
-    pub dh_size: u32,
-    pub gh_offset: u32,
-    pub ct_offset: u32,
-    pub ct_size_m: u32,
-    pub ct_size_s: u32,
-    pub ct_m_min: f32,
-    pub ct_m_max: f32,
-    pub ct_sigma_max: f32,
-    pub tt_offset: u32,
-    pub tt_size_m: u32,
-    pub tt_size_s: u32,
-    pub tt_m_min: f32,
-    pub tt_m_max: f32,
-    pub tt_sigma_max: f32,
-    pub cp_offset: u32,
-    pub cp_knots: u32,
-    pub tp_offset: u32,
-    pub tp_knots: u32,
-    pub waves_offset: u32,
-    pub dh_offset: u32,
-    pub radius: f32,
-    pub slope_bound: f32,
-    pub driver_kind: u32,
-    pub image_offset: u32,
-    pub image_levels: u32,
-    pub image_scale: f32,
-    pub image_u0: f32,
-    pub image_v0: f32,
-    pub image_lip_x: f32,
-    pub image_lip_y: f32,
-    pub c0: [f32; 3],
-    pub kappa0: f32,
-    pub sc_dir: [f32; 3],
-    pub kappa2: f32,
-    pub kappa1: f32,
-    pub combine_mode: u32,
-    pub sun: f32,
-    pub sp_knots: u32,
-    pub sp_offset: u32,
-    pub env_offset: u32,
-    pub has_env: u32,
-    pub pad1: u32,
+/// Declare a `#[repr(C)]` struct shared with WGSL: each field is `name: RustType => "wgsl type"`
+/// with its doc comment. Generates the struct, [`GpuStruct`] (its WGSL declaration and field
+/// offsets) and nothing else, so the field list exists once.
+macro_rules! gpu_struct {
+    (
+        $(#[$m:meta])*
+        $name:ident as $wgsl:literal {
+            $( $(#[doc = $doc:literal])* $field:ident : $rty:ty => $wty:literal ),* $(,)?
+        }
+    ) => {
+        $(#[$m])*
+        #[repr(C)]
+        #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+        pub struct $name {
+            $( $(#[doc = $doc])* pub $field: $rty ),*
+        }
+
+        impl GpuStruct for $name {
+            const WGSL_NAME: &'static str = $wgsl;
+            const FIELDS: &'static [(&'static str, &'static str, &'static str)] =
+                &[$((stringify!($field), $wty, concat!($($doc),*))),*];
+
+            fn offsets() -> Vec<(&'static str, usize)> {
+                vec![$((stringify!($field), std::mem::offset_of!($name, $field))),*]
+            }
+        }
+    };
 }
 
-/// Field names and byte offsets of [`GpuParams`], in declaration order (for the layout test).
-pub fn gpu_params_offsets() -> Vec<(&'static str, usize)> {
-    macro_rules! offs {
-        ($($f:ident),*) => { vec![$((stringify!($f), std::mem::offset_of!(GpuParams, $f))),*] };
+/// A struct shared with WGSL (declared by [`gpu_struct!`]).
+pub trait GpuStruct: Pod {
+    /// The struct's WGSL name.
+    const WGSL_NAME: &'static str;
+    /// `(field, WGSL type, doc)` in declaration order.
+    const FIELDS: &'static [(&'static str, &'static str, &'static str)];
+
+    /// Field names and byte offsets on the Rust side, in declaration order (for the layout test).
+    fn offsets() -> Vec<(&'static str, usize)>;
+
+    /// The WGSL declaration, each field with its doc as a comment.
+    fn wgsl() -> String {
+        let mut s = format!("struct {} {{\n", Self::WGSL_NAME);
+        for (name, ty, doc) in Self::FIELDS {
+            s.push_str(&format!("    // {}\n    {name}: {ty},\n", doc.trim()));
+        }
+        s.push_str("}\n");
+        s
     }
-    offs!(
-        eye,
-        tan_half_fov,
-        right,
-        aspect,
-        up,
-        pixel_sigma,
-        forward,
-        frame,
-        light,
-        mode,
-        attr_mean,
-        dh_ln_min,
-        attr_corr,
-        dh_ln_max,
-        width,
-        height,
-        shape,
-        wave_count,
-        sigma_h,
-        albedo,
-        specular,
-        roughness,
-        h_max,
-        g_lip,
-        min_step,
-        transfer_kind,
-        color_kind,
-        correlation,
-        height_filter,
-        slope_points,
-        g_mean,
-        g_std,
-        dh_size,
-        gh_offset,
-        ct_offset,
-        ct_size_m,
-        ct_size_s,
-        ct_m_min,
-        ct_m_max,
-        ct_sigma_max,
-        tt_offset,
-        tt_size_m,
-        tt_size_s,
-        tt_m_min,
-        tt_m_max,
-        tt_sigma_max,
-        cp_offset,
-        cp_knots,
-        tp_offset,
-        tp_knots,
-        waves_offset,
-        dh_offset,
-        radius,
-        slope_bound,
-        driver_kind,
-        image_offset,
-        image_levels,
-        image_scale,
-        image_u0,
-        image_v0,
-        image_lip_x,
-        image_lip_y,
-        c0,
-        kappa0,
-        sc_dir,
-        kappa2,
-        kappa1,
-        combine_mode,
-        sun,
-        sp_knots,
-        sp_offset,
-        env_offset,
-        has_env,
-        pad1
-    )
+}
+
+gpu_struct! {
+    /// The camera, light and pass of one view (written per frame).
+    ViewParams as "ViewParams" {
+        /// Eye position, relative to the camera target (world units).
+        eye: [f32; 3] => "vec3<f32>",
+        /// tan of half the vertical field of view.
+        tan_half_fov: f32 => "f32",
+        /// Camera right axis (unit).
+        right: [f32; 3] => "vec3<f32>",
+        /// Width / height of the image.
+        aspect: f32 => "f32",
+        /// Camera up axis (unit).
+        up: [f32; 3] => "vec3<f32>",
+        /// Standard deviation of the Gaussian pixel filter, in pixels (`camera::PIXEL_SIGMA`).
+        pixel_sigma: f32 => "f32",
+        /// Camera forward axis (unit).
+        forward: [f32; 3] => "vec3<f32>",
+        /// Ground-truth frame index (low-discrepancy sequence position); 0 for analytic modes.
+        frame: u32 => "u32",
+        /// Unit direction toward the directional light (world).
+        light: [f32; 3] => "vec3<f32>",
+        /// What the pass computes (`MODE_*`, [`crate::gpu_codes::ModeCode`]).
+        mode: u32 => "u32",
+        /// Image width in pixels.
+        width: u32 => "u32",
+        /// Image height in pixels.
+        height: u32 => "u32",
+        /// The object (`SHAPE_*`, [`crate::gpu_codes::ShapeCode`]).
+        shape: u32 => "u32",
+        /// Cylinder radius R (world units; unused for the plane).
+        radius: f32 => "f32",
+    }
+}
+
+gpu_struct! {
+    /// A material's constant parameters (written when the material is uploaded); offsets point into
+    /// the material's data buffer (binding 1), in f32 units.
+    MaterialParams as "Params" {
+        /// Attribute model ā per channel [HN12 Eq. 17].
+        attr_mean: [f32; 3] => "vec3<f32>",
+        /// ln of the smallest L of the D_h table.
+        dh_ln_min: f32 => "f32",
+        /// Attribute model a_s per channel [HN12 Eq. 17].
+        attr_corr: [f32; 3] => "vec3<f32>",
+        /// ln of the largest L of the D_h table.
+        dh_ln_max: f32 => "f32",
+        /// Number of noise waves.
+        wave_count: u32 => "u32",
+        /// Height scale σ_h.
+        sigma_h: f32 => "f32",
+        /// Diffuse albedo.
+        albedo: f32 => "f32",
+        /// Specular F0.
+        specular: f32 => "f32",
+        /// Base roughness σ_n0.
+        roughness: f32 => "f32",
+        /// Top of the surface's slab (max height).
+        h_max: f32 => "f32",
+        /// max |g′| of the transfer function (Lipschitz factor of the march).
+        g_lip: f32 => "f32",
+        /// Smallest march step.
+        min_step: f32 => "f32",
+        /// Transfer function (`TRANSFER_*`).
+        transfer_kind: u32 => "u32",
+        /// Colour model (`COLOR_*`).
+        color_kind: u32 => "u32",
+        /// Masking–shadowing correlation (`CORRELATION_*`).
+        correlation: u32 => "u32",
+        /// D_h model (`HEIGHT_FILTER_*`).
+        height_filter: u32 => "u32",
+        /// n of the n × n polar slope rule.
+        slope_points: u32 => "u32",
+        /// Mean of g(f), f ~ N(0, 1) (standardizes heights).
+        g_mean: f32 => "f32",
+        /// Std of g(f), f ~ N(0, 1).
+        g_std: f32 => "f32",
+        /// Entries of the D_h table.
+        dh_size: u32 => "u32",
+        /// Offset of the slope rule's nodes (z.x, z.y, weight).
+        slope_rule_offset: u32 => "u32",
+        /// Offset of the colour table.
+        ct_offset: u32 => "u32",
+        /// Colour table size along the mean.
+        ct_size_m: u32 => "u32",
+        /// Colour table size along σ.
+        ct_size_s: u32 => "u32",
+        /// Colour table's smallest mean.
+        ct_m_min: f32 => "f32",
+        /// Colour table's largest mean.
+        ct_m_max: f32 => "f32",
+        /// Colour table's largest σ.
+        ct_sigma_max: f32 => "f32",
+        /// Offset of the transfer table.
+        tt_offset: u32 => "u32",
+        /// Transfer table size along the mean.
+        tt_size_m: u32 => "u32",
+        /// Transfer table size along σ.
+        tt_size_s: u32 => "u32",
+        /// Transfer table's smallest mean.
+        tt_m_min: f32 => "f32",
+        /// Transfer table's largest mean.
+        tt_m_max: f32 => "f32",
+        /// Transfer table's largest σ.
+        tt_sigma_max: f32 => "f32",
+        /// Offset of the colour map's polynomial.
+        cp_offset: u32 => "u32",
+        /// Knots of the colour map's polynomial.
+        cp_knots: u32 => "u32",
+        /// Offset of the transfer function's polynomial (g, g′).
+        tp_offset: u32 => "u32",
+        /// Knots of the transfer function's polynomial.
+        tp_knots: u32 => "u32",
+        /// Offset of the waves (k.x, k.y, amplitude, phase).
+        waves_offset: u32 => "u32",
+        /// Offset of the D_h table (mean, std per entry).
+        dh_offset: u32 => "u32",
+        /// Bound of |∇h| (the cylinder's march rate).
+        slope_bound: f32 => "f32",
+        /// Driver (`DRIVER_*`).
+        driver_kind: u32 => "u32",
+        /// Offset of the image pyramid's level records.
+        image_offset: u32 => "u32",
+        /// Levels of the image pyramid.
+        image_levels: u32 => "u32",
+        /// Level-0 texels per world unit.
+        image_scale: f32 => "f32",
+        /// Level-0 texel coordinate of the camera target, x.
+        image_u0: f32 => "f32",
+        /// Level-0 texel coordinate of the camera target, y.
+        image_v0: f32 => "f32",
+        /// Lipschitz bound of the image along x (per texel).
+        image_lip_x: f32 => "f32",
+        /// Lipschitz bound of the image along y (per texel).
+        image_lip_y: f32 => "f32",
+        /// Constant colour term C0 (linear RGB) [HNPN14 Sec. 6].
+        c0: [f32; 3] => "vec3<f32>",
+        /// Weight κ0 of C0 (0 when absent).
+        kappa0: f32 => "f32",
+        /// Slope colour direction d (unit, world).
+        sc_dir: [f32; 3] => "vec3<f32>",
+        /// Weight κ2 of the slope colour C_s (0 when absent).
+        kappa2: f32 => "f32",
+        /// Weight κ1 of the colour model C_h.
+        kappa1: f32 => "f32",
+        /// Combination of the terms (`COMBINE_*`).
+        combine_mode: u32 => "u32",
+        /// Strength of the directional light.
+        sun: f32 => "f32",
+        /// Knots of the slope colour's polynomial.
+        sp_knots: u32 => "u32",
+        /// Offset of the slope colour's polynomial.
+        sp_offset: u32 => "u32",
+        /// Offset of the environment's SH9 irradiance coefficients.
+        env_offset: u32 => "u32",
+        /// 1 when there is an environment light.
+        has_env: u32 => "u32",
+        /// Padding to 16 bytes.
+        pad: u32 => "u32",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The generated WGSL names every field with its type, in order.
+    #[test]
+    fn wgsl_declarations_list_every_field() {
+        let w = MaterialParams::wgsl();
+        assert!(w.starts_with("struct Params {"));
+        assert_eq!(
+            w.matches(": u32,").count()
+                + w.matches(": f32,").count()
+                + w.matches(": vec3<f32>,").count(),
+            MaterialParams::FIELDS.len()
+        );
+        assert!(w.contains("    sigma_h: f32,"));
+        assert!(ViewParams::wgsl().contains("    eye: vec3<f32>,"));
+        assert_eq!(ViewParams::offsets().len(), ViewParams::FIELDS.len());
+    }
 }

@@ -9,6 +9,7 @@ pub mod compute;
 pub mod error_map;
 pub mod export;
 pub mod gpu;
+pub mod gpu_codes;
 pub mod gpu_types;
 pub mod renderer;
 pub mod shaders;

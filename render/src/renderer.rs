@@ -2,22 +2,27 @@
 //! linear f32 and 8-bit sRGB images. One accumulation target per view.
 
 use crate::gpu::GpuContext;
-use crate::gpu_types::GpuParams;
+use crate::gpu_codes::{
+    ColorCode, CombineCode, CorrelationCode, DriverCode, HeightFilterCode, ModeCode, ShapeCode,
+    TransferCode,
+};
+use crate::gpu_types::{MaterialParams, ViewParams};
 use crate::specialize::{SpecializeError, view_source_for};
 use glam::DVec3;
-use lodestone_core::camera::{Camera, PIXEL_SIGMA};
-use lodestone_core::color_terms::CombineMode;
-use lodestone_core::colormap::linear_to_srgb;
-use lodestone_core::cylinder::Shape;
-use lodestone_core::driver_field::{DriverField, TiledImage};
-use lodestone_core::effective_height::{EffectiveHeightTable, HeightFilter};
-use lodestone_core::features::{Feature, FeatureSet};
-use lodestone_core::footprint::{Prepared, slope_rule};
+use lodestone_core::driver::field::{DriverField, TiledImage};
+use lodestone_core::eval::Evaluator;
+use lodestone_core::material::color_terms::CombineMode;
+use lodestone_core::material::colormap::linear_to_srgb;
+use lodestone_core::material::features::{Feature, FeatureSet};
+use lodestone_core::material::preconvolved::PreconvolvedTable;
+use lodestone_core::material::transfer::TransferFunction;
 use lodestone_core::material::{ColorModel, ColorSource};
-use lodestone_core::piecewise::PiecewisePoly;
-use lodestone_core::preconvolved::PreconvolvedTable;
-use lodestone_core::shadowing::Correlation;
-use lodestone_core::transfer::TransferFunction;
+use lodestone_core::math::piecewise::PiecewisePoly;
+use lodestone_core::microfacet::effective_height::{EffectiveHeightTable, HeightFilter};
+use lodestone_core::microfacet::masking_shadowing::Correlation;
+use lodestone_core::microfacet::visible_slopes::slope_rule;
+use lodestone_core::scene::camera::{Camera, PIXEL_SIGMA};
+use lodestone_core::scene::shape::Shape;
 use std::collections::HashMap;
 use std::f64::consts::TAU;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -47,11 +52,12 @@ pub enum ViewMode {
 impl ViewMode {
     fn code(self) -> u32 {
         match self {
-            Self::Naive => 0,
-            Self::ViewIndependent => 1,
-            Self::Filtered => 2,
-            Self::Truth => 3,
+            Self::Naive => ModeCode::Naive,
+            Self::ViewIndependent => ModeCode::ViewIndependent,
+            Self::Filtered => ModeCode::Filtered,
+            Self::Truth => ModeCode::Truth,
         }
+        .code()
     }
 }
 
@@ -111,16 +117,16 @@ struct Layout {
     color_table: u32,
     transfer_table: u32,
     dh: u32,
-    gh: u32,
+    slope_rule: u32,
     color_poly: u32,
     transfer_poly: u32,
 }
 
-/// A material uploaded for the GPU: its data buffer and the constant part of its parameters.
+/// A material uploaded for the GPU: its data buffer and its parameters (both constant).
 #[derive(Debug)]
 pub struct GpuMaterial {
     data: wgpu::Buffer,
-    base: GpuParams,
+    params: wgpu::Buffer,
     target: [f64; 2],
     /// The material's own features ([`FeatureSet::of_material`]).
     features: FeatureSet,
@@ -131,13 +137,13 @@ pub struct GpuMaterial {
 }
 
 /// One view's render target: an accumulation buffer (linear RGB + sample count per pixel) and its
-/// own parameter buffer, so several views can be drawn in one submission without sharing state.
+/// own view parameters, so several views can be drawn in one submission without sharing state.
 #[derive(Debug)]
 pub struct ViewTarget {
     width: u32,
     height: u32,
     accum: wgpu::Buffer,
-    params: wgpu::Buffer,
+    view: wgpu::Buffer,
     /// Ground-truth rays per pixel accumulated so far.
     pub samples: u32,
 }
@@ -153,9 +159,9 @@ impl ViewTarget {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let params = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("params"),
-            size: std::mem::size_of::<GpuParams>() as u64,
+        let view = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("view params"),
+            size: std::mem::size_of::<ViewParams>() as u64,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -163,7 +169,7 @@ impl ViewTarget {
             width,
             height,
             accum,
-            params,
+            view,
             samples: 0,
         }
     }
@@ -321,7 +327,12 @@ fn push_poly(data: &mut Vec<f32>, p: &PiecewisePoly, channels: &[usize]) -> u32 
 /// The image pyramid: per level the value grid (f̄, f²‾) and the cell grid (f_x, f_y, f_x², f_y²,
 /// f_x·f_y), then a level table of 5 slots per level (value offset, grad offset, width, height as
 /// u32 bits; mean variance as f32). The target is folded into the texel origin in f64.
-fn push_image(data: &mut Vec<f32>, base: &mut GpuParams, tiled: &TiledImage, target: [f64; 2]) {
+fn push_image(
+    data: &mut Vec<f32>,
+    base: &mut MaterialParams,
+    tiled: &TiledImage,
+    target: [f64; 2],
+) {
     let img = &tiled.image;
     let mut offsets = Vec::with_capacity(img.levels.len());
     for l in &img.levels {
@@ -343,7 +354,7 @@ fn push_image(data: &mut Vec<f32>, base: &mut GpuParams, tiled: &TiledImage, tar
     }
     let scale = tiled.texels_per_unit();
     let (w, h) = img.size();
-    base.driver_kind = 1;
+    base.driver_kind = DriverCode::Image.code();
     base.image_levels = img.levels.len() as u32;
     base.image_scale = scale as f32;
     base.image_u0 = (target[0] * scale).rem_euclid(w as f64) as f32;
@@ -352,9 +363,9 @@ fn push_image(data: &mut Vec<f32>, base: &mut GpuParams, tiled: &TiledImage, tar
     base.image_lip_y = img.lipschitz.y as f32;
 }
 
-/// The material's data buffer and the material part of the WGSL `Params`, see [`material_data_for`]
+/// The material's data buffer and its parameters (WGSL `Params`), see [`material_data_for`]
 /// (with every table the material has: what the all-features shader reads).
-pub fn material_data(prepared: &Prepared, target: [f64; 2]) -> (Vec<f32>, GpuParams) {
+pub fn material_data(prepared: &Evaluator, target: [f64; 2]) -> (Vec<f32>, MaterialParams) {
     let d = material_data_for(prepared, target, FeatureSet::all());
     (d.data, d.params)
 }
@@ -364,21 +375,21 @@ pub fn material_data(prepared: &Prepared, target: [f64; 2]) -> (Vec<f32>, GpuPar
 pub struct MaterialData {
     /// The data buffer (f32 words).
     pub data: Vec<f32>,
-    /// The material part of the parameters.
-    pub params: GpuParams,
+    /// The material's parameters.
+    pub params: MaterialParams,
     /// Bytes of each part present (waves, image pyramid, colour table, …).
     pub segments: Vec<(&'static str, usize)>,
 }
 
 /// The material's data buffer (waves, image pyramid, tables, D_h, quadrature rule, curve
-/// polynomials, as f32) and the material part of the WGSL `Params`, with coordinates relative to
+/// polynomials, as f32) and its parameters (WGSL `Params`), with coordinates relative to
 /// `target`: each wave's phase absorbs 2π k·target in f64, so f32 phases stay accurate anywhere
 /// on the plane. Parts the material has but `features` does not use are left out: the D_h table
 /// and the slope quadrature rule need [`Feature::Relief`] (the colour and transfer tables, the
 /// image and the waves exist only for the materials that use them). Shared by the renderer and
 /// the engine bundle ([`crate::export`]).
 pub fn material_data_for(
-    prepared: &Prepared,
+    prepared: &Evaluator,
     target: [f64; 2],
     features: FeatureSet,
 ) -> MaterialData {
@@ -395,7 +406,7 @@ pub fn material_data_for(
         waves: 0,
         ..Layout::default()
     };
-    let mut base = GpuParams::default();
+    let mut base = MaterialParams::default();
     let start = data.len();
     match &s.driver {
         DriverField::Noise(noise) => {
@@ -416,7 +427,7 @@ pub fn material_data_for(
             DriverField::Image(_) => "image pyramid",
         },
     );
-    if let Some(t) = &prepared.color_table {
+    if let Some(t) = prepared.color.table() {
         let start = data.len();
         lay.color_table = push_table(&mut data, t);
         mark(&data, start, "colour table");
@@ -426,7 +437,7 @@ pub fn material_data_for(
         base.ct_m_max = t.m_max as f32;
         base.ct_sigma_max = t.sigma_max as f32;
     }
-    if let Some(t) = &prepared.transfer_table {
+    if let Some(t) = prepared.transfer.table() {
         let start = data.len();
         lay.transfer_table = push_table(&mut data, t);
         mark(&data, start, "transfer table");
@@ -450,7 +461,7 @@ pub fn material_data_for(
         }
         mark(&data, start, "visible-height table D_h");
         let start = data.len();
-        lay.gh = data.len() as u32;
+        lay.slope_rule = data.len() as u32;
         for (z, w) in slope_rule(points) {
             data.extend([z.x as f32, z.y as f32, *w as f32]);
         }
@@ -464,19 +475,24 @@ pub fn material_data_for(
             mark(&data, start, "colour map polynomial");
             base.cp_knots = p.knots.len() as u32;
             base.color_kind = match source {
-                ColorSource::Driver => 0,
-                ColorSource::Height => 1,
-            };
+                ColorSource::Driver => ColorCode::Driver,
+                ColorSource::Height => ColorCode::Height,
+            }
+            .code();
         }
         ColorModel::Attribute { mean, correlation } => {
-            base.color_kind = 2;
+            base.color_kind = ColorCode::Attribute.code();
             base.attr_mean = mean.map(|v| v as f32);
             base.attr_corr = correlation.map(|v| v as f32);
         }
     }
     // Colour terms: an absent term has weight 0 (see material.wgsl's `affine`).
     let terms = &m.terms;
-    base.combine_mode = u32::from(terms.mode == CombineMode::Multiplicative);
+    base.combine_mode = match terms.mode {
+        CombineMode::Linear => CombineCode::Linear,
+        CombineMode::Multiplicative => CombineCode::Multiplicative,
+    }
+    .code();
     if let Some(c) = &terms.constant {
         base.c0 = c.color.map(|v| v as f32);
         base.kappa0 = c.weight as f32;
@@ -510,7 +526,7 @@ pub fn material_data_for(
         lay.transfer_poly = push_poly(&mut data, &p, &[0, 2]);
         mark(&data, start, "transfer polynomial");
         base.tp_knots = p.knots.len() as u32;
-        base.transfer_kind = 1;
+        base.transfer_kind = TransferCode::Curve.code();
     }
     if data.is_empty() {
         data.push(0.0);
@@ -519,7 +535,7 @@ pub fn material_data_for(
     base.ct_offset = lay.color_table;
     base.tt_offset = lay.transfer_table;
     base.dh_offset = lay.dh;
-    base.gh_offset = lay.gh;
+    base.slope_rule_offset = lay.slope_rule;
     base.slope_points = points as u32;
     base.cp_offset = lay.color_poly;
     base.tp_offset = lay.transfer_poly;
@@ -531,10 +547,18 @@ pub fn material_data_for(
     base.g_lip = s.g_lip as f32;
     base.min_step = s.min_step as f32;
     base.slope_bound = s.slope_bound() as f32;
-    base.correlation = u32::from(m.filtering.correlation == Correlation::HeightDirection);
-    base.height_filter = u32::from(m.filtering.height_filter == HeightFilter::PaperFit);
-    base.g_mean = prepared.g_global.0 as f32;
-    base.g_std = prepared.g_global.1 as f32;
+    base.correlation = match m.filtering.correlation {
+        Correlation::Uncorrelated => CorrelationCode::Uncorrelated,
+        Correlation::HeightDirection => CorrelationCode::HeightDirection,
+    }
+    .code();
+    base.height_filter = match m.filtering.height_filter {
+        HeightFilter::Exact => HeightFilterCode::Exact,
+        HeightFilter::PaperFit => HeightFilterCode::PaperFit,
+    }
+    .code();
+    base.g_mean = prepared.global_height.0 as f32;
+    base.g_std = prepared.global_height.1 as f32;
     MaterialData {
         data,
         params: base,
@@ -546,21 +570,21 @@ impl GpuMaterial {
     /// Upload a prepared material with coordinates relative to `target` (the camera target), with
     /// only the data its features use ([`material_data_for`]); drawn by pipelines specialised to
     /// the material and scene.
-    pub fn new(ctx: &GpuContext, prepared: &Prepared, target: [f64; 2]) -> Self {
+    pub fn new(ctx: &GpuContext, prepared: &Evaluator, target: [f64; 2]) -> Self {
         let features = FeatureSet::of_material(&prepared.material);
         Self::upload(ctx, prepared, target, features, false)
     }
 
     /// Upload every table the material has, to be drawn by the all-features pipeline (the
     /// reference the specialised pipelines are compared against, and the engine bundle's shader).
-    pub fn all_features(ctx: &GpuContext, prepared: &Prepared, target: [f64; 2]) -> Self {
+    pub fn all_features(ctx: &GpuContext, prepared: &Evaluator, target: [f64; 2]) -> Self {
         let features = FeatureSet::of_material(&prepared.material);
         Self::upload(ctx, prepared, target, features, true)
     }
 
     fn upload(
         ctx: &GpuContext,
-        prepared: &Prepared,
+        prepared: &Evaluator,
         target: [f64; 2],
         features: FeatureSet,
         all_features: bool,
@@ -586,9 +610,17 @@ impl GpuMaterial {
         });
         ctx.queue
             .write_buffer(&buffer, 0, bytemuck::cast_slice(&data));
+        let params_buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("material params"),
+            size: std::mem::size_of::<MaterialParams>() as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        ctx.queue
+            .write_buffer(&params_buffer, 0, bytemuck::bytes_of(&params));
         Self {
             data: buffer,
-            base: params,
+            params: params_buffer,
             target,
             features,
             all_features,
@@ -724,7 +756,7 @@ impl Renderer {
             .pipelines
             .get(&self.ctx.device, material.pipeline_features(scene))
             .pipeline;
-        let mut params = material.base;
+        let mut params = ViewParams::default();
         let cam = Camera {
             target: [0.0, 0.0],
             ..scene.camera
@@ -743,9 +775,9 @@ impl Renderer {
         params.height = height;
         params.mode = mode.code();
         match scene.shape {
-            Shape::Plane => params.shape = 0,
+            Shape::Plane => params.shape = ShapeCode::Plane.code(),
             Shape::Cylinder { radius } => {
-                params.shape = 1;
+                params.shape = ShapeCode::Cylinder.code();
                 params.radius = radius as f32;
             }
         }
@@ -758,7 +790,7 @@ impl Renderer {
                 entries: &[
                     wgpu::BindGroupEntry {
                         binding: 0,
-                        resource: target.params.as_entire_binding(),
+                        resource: material.params.as_entire_binding(),
                     },
                     wgpu::BindGroupEntry {
                         binding: 1,
@@ -767,6 +799,10 @@ impl Renderer {
                     wgpu::BindGroupEntry {
                         binding: 2,
                         resource: target.accum.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: target.view.as_entire_binding(),
                     },
                 ],
             });
@@ -783,7 +819,7 @@ impl Renderer {
             };
             self.ctx
                 .queue
-                .write_buffer(&target.params, 0, bytemuck::bytes_of(&params));
+                .write_buffer(&target.view, 0, bytemuck::bytes_of(&params));
             let mut enc = self
                 .ctx
                 .device

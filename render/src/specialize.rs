@@ -25,7 +25,7 @@
 //! can be read, validated and exported. The price is one pipeline per feature set, which the
 //! renderer caches.
 
-use lodestone_core::features::{Feature, FeatureSet};
+use lodestone_core::material::features::{Feature, FeatureSet};
 
 /// A malformed directive in a shader source (a bug in the shipped WGSL; tests catch it).
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -144,10 +144,11 @@ pub fn specialize(source: &str, features: FeatureSet) -> Result<String, Speciali
 pub fn view_source_for(features: FeatureSet) -> Result<String, SpecializeError> {
     use crate::shaders;
     let features = features.normalized();
-    let mut parts = vec![shaders::SPECIAL, shaders::MATERIAL];
+    let mut parts = vec![shaders::SPECIAL, shaders::material()];
     if features.contains(Feature::ImageDriver) {
         parts.push(shaders::IMAGE_DRIVER);
     }
+    parts.push(shaders::view_bindings());
     if features.contains(Feature::Curved) {
         parts.push(shaders::CYLINDER);
     }

@@ -3,19 +3,12 @@
 //! params.bin and data.bin, equals core's filtered evaluation on sample inputs.
 
 use glam::{DMat2, DVec2};
-use lodestone_core::footprint::{Config, Prepared};
+use lodestone_core::driver::footprint::Footprint;
+use lodestone_core::eval::{Evaluator, FootprintQuery};
 use lodestone_core::material::Material;
-use lodestone_core::noise::Footprint;
-use lodestone_core::smith::direction;
-use lodestone_render::GpuContext;
+use lodestone_core::scene::direction::direction;
 use lodestone_render::export::{ENTRY_POINT, INPUT_STRIDE, bundle, snippet_glsl, snippet_wgsl};
-
-fn preset(name: &str) -> Material {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../presets")
-        .join(name);
-    Material::from_ron(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
+use lodestone_tests::preset;
 
 fn file<'a>(files: &'a [(String, Vec<u8>)], name: &str) -> &'a [u8] {
     &files
@@ -56,7 +49,7 @@ fn snippets_parse_in_wgsl_and_glsl() {
 #[test]
 fn bundle_files_match_the_manifest() {
     for name in ["default.ron", "moss.ron", "dirt-in-crevices.ron"] {
-        let p = Prepared::new(&preset(name)).unwrap();
+        let p = Evaluator::new(&preset(name)).unwrap();
         let files = bundle(&p).expect("bundle");
         let manifest: serde_json::Value =
             serde_json::from_slice(file(&files, "manifest.json")).expect("manifest is JSON");
@@ -102,14 +95,10 @@ fn bundle_files_match_the_manifest() {
 /// The WGSL snippet with the bundle's buffers, on the adapter, against core's f64 evaluation.
 #[test]
 fn wgsl_snippet_equals_core_filtered() {
-    let ctx = match GpuContext::new_headless() {
-        Ok(c) => c,
-        Err(e) => {
-            eprintln!("skipping: {e}");
-            return;
-        }
+    let Some(ctx) = lodestone_tests::gpu("the WGSL snippet test") else {
+        return;
     };
-    let p = Prepared::new(&preset("default.ron")).unwrap();
+    let p = Evaluator::new(&preset("default.ron")).unwrap();
     let files = bundle(&p).unwrap();
     // Sample inputs: positions, footprints from sub-feature to many features, view and light
     // from overhead to 80°.
@@ -146,7 +135,7 @@ fn wgsl_snippet_equals_core_filtered() {
             wi.z as f32,
             0.0,
         ]);
-        configs.push(Config {
+        configs.push(FootprintQuery {
             wo,
             wi,
             x0,
@@ -271,9 +260,9 @@ fn image_driver_bundle_describes_the_pyramid() {
     };
     let values: Vec<f32> = (0..64 * 32).map(|i| ((i * 37) % 101) as f32).collect();
     let img = std::sync::Arc::new(
-        lodestone_core::image_driver::ImageDriver::new(64, 32, &values).unwrap(),
+        lodestone_core::driver::image::ImageDriver::new(64, 32, &values).unwrap(),
     );
-    let p = lodestone_core::footprint::Prepared::with_image(&m, Some(img.clone()), None).unwrap();
+    let p = lodestone_core::eval::Evaluator::with_image(&m, Some(img.clone()), None).unwrap();
     let files = bundle(&p).expect("bundle");
     let manifest: serde_json::Value =
         serde_json::from_slice(file(&files, "manifest.json")).unwrap();

@@ -1,20 +1,14 @@
 //! The pipeline cache: one pipeline per feature set, compiled on first use or ahead of use on a
 //! background thread, never twice.
 
-use lodestone_core::features::{Feature, FeatureSet};
-use lodestone_render::{GpuContext, Renderer};
+use lodestone_core::material::features::{Feature, FeatureSet};
 use std::time::{Duration, Instant};
 
 #[test]
 fn prewarmed_pipelines_are_ready_without_compiling_at_draw_time() {
-    let ctx = match GpuContext::new_headless() {
-        Ok(c) => c,
-        Err(e) => {
-            eprintln!("skipping: {e}");
-            return;
-        }
+    let Some(r) = lodestone_tests::renderer("the pipeline test") else {
+        return;
     };
-    let r = Renderer::new(ctx);
     let flat: FeatureSet = [Feature::NoiseDriver, Feature::DriverColor]
         .into_iter()
         .collect();

@@ -1,9 +1,10 @@
 //! Every WGSL file validates with naga, and the WGSL mirrors agree with lodestone-core on the GPU
 //! adapter (llvmpipe on CI) over ≥ 10,000 inputs, extremes included.
 
-use lodestone_core::features::FeatureSet;
-use lodestone_core::{special, special_f32};
-use lodestone_render::{GpuContext, compute::eval_unary, shaders};
+use lodestone_core::material::features::FeatureSet;
+use lodestone_core::math::{special, special_f32};
+use lodestone_render::gpu_types::{GpuStruct, MaterialParams, ViewParams};
+use lodestone_render::{compute::eval_unary, shaders};
 
 /// Parse and validate a file together with the files it needs.
 fn module_for(name: &str, file: &str) -> naga::Module {
@@ -24,10 +25,10 @@ fn module_for(name: &str, file: &str) -> naga::Module {
 
 #[test]
 fn every_wgsl_file_validates() {
-    for (name, file) in shaders::ALL {
+    for (name, file) in shaders::all() {
         let module = module_for(name, file);
         // The mirrored functions exist under core's names.
-        if *name == "special.wgsl" {
+        if name == "special" {
             for f in shaders::SPECIAL_MIRRORED {
                 assert!(
                     module
@@ -41,20 +42,419 @@ fn every_wgsl_file_validates() {
     }
 }
 
+/// `(WGSL file, WGSL function, core file, core function)`: every function of every WGSL file mirrors
+/// the core function named here (a method is named without its type), or is GPU-only ([`GPU_ONLY`]).
+/// Same name, same folder unless the entry says otherwise.
+const MIRRORS: &[(&str, &str, &str, &str)] = &[
+    (
+        "math/special.wgsl",
+        "erfc_upper",
+        "math/special_f32.rs",
+        "erfc_upper",
+    ),
+    (
+        "math/special.wgsl",
+        "erf_small",
+        "math/special_f32.rs",
+        "erf_small",
+    ),
+    (
+        "math/piecewise.wgsl",
+        "poly_eval",
+        "math/piecewise.rs",
+        "eval",
+    ),
+    (
+        "microfacet/smith.wgsl",
+        "projected_std",
+        "microfacet/slopes.rs",
+        "projected_std",
+    ),
+    (
+        "microfacet/masking_shadowing.wgsl",
+        "masking_shadowing",
+        "microfacet/masking_shadowing.rs",
+        "from_directions",
+    ),
+    (
+        "microfacet/visible_slopes.wgsl",
+        "slope_node",
+        "microfacet/visible_slopes.rs",
+        "slope_rule",
+    ),
+    (
+        "material/preconvolved.wgsl",
+        "split_coord",
+        "material/preconvolved.rs",
+        "split",
+    ),
+    (
+        "material/preconvolved.wgsl",
+        "table_sample",
+        "material/preconvolved.rs",
+        "sample",
+    ),
+    (
+        "material/transfer.wgsl",
+        "transfer_eval",
+        "material/transfer.rs",
+        "eval",
+    ),
+    (
+        "material/transfer.wgsl",
+        "transfer_moments",
+        "eval/compiled.rs",
+        "moments",
+    ),
+    (
+        "driver/noise.wgsl",
+        "wave_term",
+        "driver/noise.rs",
+        "value_and_gradient",
+    ),
+    (
+        "driver/field.wgsl",
+        "filtered_driver",
+        "driver/field.rs",
+        "filtered",
+    ),
+    ("driver/image.wgsl", "image_wrap", "driver/image.rs", "cell"),
+    ("driver/image.wgsl", "image_cell", "driver/image.rs", "cell"),
+    (
+        "driver/image.wgsl",
+        "image_at_level",
+        "driver/image.rs",
+        "at_level",
+    ),
+    (
+        "driver/image.wgsl",
+        "image_bilerp",
+        "driver/image.rs",
+        "bilerp",
+    ),
+    (
+        "driver/image.wgsl",
+        "image_value_and_gradient",
+        "driver/image.rs",
+        "value_and_gradient",
+    ),
+    ("driver/image.wgsl", "image_plan", "driver/image.rs", "plan"),
+    (
+        "driver/image.wgsl",
+        "image_level_moments",
+        "driver/image.rs",
+        "level_moments",
+    ),
+    (
+        "driver/image.wgsl",
+        "image_mix",
+        "driver/image.rs",
+        "moments_at",
+    ),
+    (
+        "driver/image.wgsl",
+        "image_split_lod",
+        "driver/image.rs",
+        "split_lod",
+    ),
+    (
+        "driver/image.wgsl",
+        "image_moments_at",
+        "driver/image.rs",
+        "moments_at",
+    ),
+    (
+        "driver/image.wgsl",
+        "image_footprint_moments",
+        "driver/image.rs",
+        "footprint_moments",
+    ),
+    (
+        "driver/image.wgsl",
+        "image_level_mean",
+        "driver/image.rs",
+        "level_mean",
+    ),
+    (
+        "driver/image.wgsl",
+        "image_footprint_mean",
+        "driver/image.rs",
+        "footprint_mean",
+    ),
+    (
+        "driver/image.wgsl",
+        "image_mean_std",
+        "driver/image.rs",
+        "mean_std",
+    ),
+    (
+        "driver/image.wgsl",
+        "image_texel",
+        "driver/field.rs",
+        "texels_per_unit",
+    ),
+    (
+        "driver/image.wgsl",
+        "image_grad_cov",
+        "driver/image.rs",
+        "grad_cov",
+    ),
+    (
+        "driver/image.wgsl",
+        "image_filtered_driver",
+        "driver/field.rs",
+        "filtered",
+    ),
+    (
+        "driver/image.wgsl",
+        "image_lipschitz_along",
+        "driver/field.rs",
+        "lipschitz_along",
+    ),
+    (
+        "scene/direction.wgsl",
+        "basis_t",
+        "scene/direction.rs",
+        "basis",
+    ),
+    (
+        "scene/direction.wgsl",
+        "basis_b",
+        "scene/direction.rs",
+        "basis",
+    ),
+    (
+        "scene/surface.wgsl",
+        "surface_height",
+        "scene/surface.rs",
+        "height",
+    ),
+    (
+        "scene/cylinder.wgsl",
+        "cylinder_to_surface",
+        "scene/cylinder.rs",
+        "to_surface",
+    ),
+    (
+        "scene/cylinder.wgsl",
+        "cylinder_frame",
+        "scene/cylinder.rs",
+        "frame",
+    ),
+    (
+        "scene/cylinder.wgsl",
+        "cylinder_intersect",
+        "scene/cylinder.rs",
+        "intersect",
+    ),
+    (
+        "scene/cylinder.wgsl",
+        "cylinder_gap",
+        "eval/cylinder.rs",
+        "cylinder_march",
+    ),
+    (
+        "scene/cylinder.wgsl",
+        "cylinder_march",
+        "eval/cylinder.rs",
+        "cylinder_march",
+    ),
+    (
+        "scene/cylinder.wgsl",
+        "cylinder_trace_ray",
+        "eval/cylinder.rs",
+        "cylinder_trace_ray",
+    ),
+    (
+        "scene/cylinder.wgsl",
+        "tangent_footprint",
+        "scene/cylinder.rs",
+        "tangent_footprint",
+    ),
+    (
+        "scene/cylinder.wgsl",
+        "cylinder_pixel",
+        "eval/cylinder.rs",
+        "cylinder_pixel",
+    ),
+    (
+        "eval/compiled.wgsl",
+        "point_input",
+        "eval/compiled.rs",
+        "at_point",
+    ),
+    (
+        "eval/compiled.wgsl",
+        "color_at",
+        "eval/evaluator.rs",
+        "color_at",
+    ),
+    (
+        "eval/compiled.wgsl",
+        "color_of_distribution",
+        "eval/compiled.rs",
+        "of_distribution",
+    ),
+    ("eval/naive.wgsl", "eval_naive", "eval/naive.rs", "naive"),
+    (
+        "eval/view_independent.wgsl",
+        "eval_view_independent",
+        "eval/view_independent.rs",
+        "view_independent",
+    ),
+    (
+        "eval/view_independent.wgsl",
+        "slope_color_mean",
+        "microfacet/visible_slopes.rs",
+        "slope_mean",
+    ),
+    (
+        "eval/filtered.wgsl",
+        "eval_filtered",
+        "eval/filtered.rs",
+        "filtered",
+    ),
+    (
+        "eval/ground_truth.wgsl",
+        "shade_point",
+        "eval/ground_truth.rs",
+        "shade_hit",
+    ),
+    (
+        "eval/lod_surface.wgsl",
+        "lod_prepare",
+        "driver/field.rs",
+        "lod_moments",
+    ),
+    (
+        "eval/lod_surface.wgsl",
+        "lod_term",
+        "driver/field.rs",
+        "lod_moments",
+    ),
+    (
+        "eval/lod_surface.wgsl",
+        "lod_mean",
+        "driver/field.rs",
+        "lod_moments",
+    ),
+    (
+        "eval/pixel.wgsl",
+        "analytic_pixel",
+        "eval/pixel.rs",
+        "pixel_in_frame",
+    ),
+    ("view.wgsl", "raw_dir", "scene/camera.rs", "raw_dir"),
+    (
+        "view.wgsl",
+        "plane_footprint",
+        "scene/camera.rs",
+        "plane_footprint",
+    ),
+];
+
+/// WGSL functions with no core counterpart, and why.
+const GPU_ONLY: &[(&str, &str, &str)] = &[
+    (
+        "driver/noise.wgsl",
+        "wave",
+        "reads wave i from the data buffer",
+    ),
+    (
+        "driver/image.wgsl",
+        "image_level",
+        "reads a pyramid level's record from the data buffer",
+    ),
+    (
+        "material/preconvolved.wgsl",
+        "texel4",
+        "reads a table texel from the data buffer",
+    ),
+    (
+        "eval/shading.wgsl",
+        "has_environment",
+        "the parameter flag for an environment",
+    ),
+    (
+        "scene/surface.wgsl",
+        "field_height",
+        "selects the explicit or level-of-detail surface for the one march",
+    ),
+    (
+        "view.wgsl",
+        "pcg",
+        "per-pixel random numbers of the progressive ground truth",
+    ),
+    ("view.wgsl", "view_main", "the compute entry point"),
+];
+
+/// Functions defined at module scope of a WGSL source.
+fn wgsl_functions(src: &str) -> Vec<&str> {
+    src.lines()
+        .filter_map(|l| l.strip_prefix("fn "))
+        .filter_map(|l| l.split('(').next())
+        .collect()
+}
+
+/// Every WGSL function of every file mirrors a named core function, found in the named core file
+/// (or is listed as GPU-only); without an entry, a function mirrors the function of the same name
+/// in the core file at the same path.
 #[test]
-fn gpu_params_match_the_wgsl_layout() {
-    let module = module_for("material.wgsl", shaders::MATERIAL);
+fn every_wgsl_function_mirrors_a_core_function() {
+    let core = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../core/src");
+    let defines = |file: &str, f: &str| {
+        let src = std::fs::read_to_string(core.join(file))
+            .unwrap_or_else(|e| panic!("core/src/{file}: {e}"));
+        src.contains(&format!("fn {f}(")) || src.contains(&format!("fn {f}<"))
+    };
+    let mut checked = 0;
+    for (path, src) in shaders::files() {
+        let fns = wgsl_functions(src);
+        assert!(
+            !fns.is_empty() || src.contains("\nstruct ") || path == "bindings.wgsl",
+            "{path} declares neither a function nor a struct"
+        );
+        for f in fns {
+            if GPU_ONLY.iter().any(|(p, g, _)| *p == path && *g == f) {
+                continue;
+            }
+            let (file, name) = match MIRRORS.iter().find(|(p, g, _, _)| *p == path && *g == f) {
+                Some((_, _, file, name)) => (file.to_string(), *name),
+                None => (path.replace(".wgsl", ".rs"), f),
+            };
+            assert!(
+                defines(&file, name),
+                "{path}: `{f}` mirrors no `fn {name}` in core/src/{file}; add it to MIRRORS or GPU_ONLY"
+            );
+            checked += 1;
+        }
+    }
+    for (path, f, ..) in MIRRORS.iter().map(|(p, f, a, b)| (p, f, a, b)) {
+        let src = shaders::files()
+            .into_iter()
+            .find(|(p, _)| p == path)
+            .map(|(_, s)| s);
+        assert!(
+            src.is_some_and(|s| wgsl_functions(s).contains(f)),
+            "MIRRORS names {path}::{f}, which does not exist"
+        );
+    }
+    assert!(checked > 90, "only {checked} functions checked");
+}
+
+/// The Rust offsets of a [`GpuStruct`] equal naga's layout of its generated WGSL.
+fn check_layout<T: GpuStruct>(module: &naga::Module) {
     let mut layouter = naga::proc::Layouter::default();
     layouter.update(module.to_ctx()).expect("layout");
-    let (handle, ty) = module
+    let (_, ty) = module
         .types
         .iter()
-        .find(|(_, t)| t.name.as_deref() == Some("Params"))
-        .expect("struct Params");
+        .find(|(_, t)| t.name.as_deref() == Some(T::WGSL_NAME))
+        .unwrap_or_else(|| panic!("struct {}", T::WGSL_NAME));
     let naga::TypeInner::Struct { members, span } = &ty.inner else {
-        panic!("Params is not a struct")
+        panic!("{} is not a struct", T::WGSL_NAME)
     };
-    let rust = lodestone_render::gpu_types::gpu_params_offsets();
+    let rust = T::offsets();
     assert_eq!(members.len(), rust.len(), "field count");
     for (m, (name, off)) in members.iter().zip(&rust) {
         assert_eq!(m.name.as_deref(), Some(*name), "field order");
@@ -62,10 +462,16 @@ fn gpu_params_match_the_wgsl_layout() {
     }
     assert_eq!(
         *span as usize,
-        std::mem::size_of::<lodestone_render::gpu_types::GpuParams>(),
-        "size"
+        std::mem::size_of::<T>(),
+        "size of {}",
+        T::WGSL_NAME
     );
-    let _ = layouter[handle].size;
+}
+
+#[test]
+fn gpu_params_match_the_wgsl_layout() {
+    check_layout::<MaterialParams>(&module_for("material", shaders::material()));
+    check_layout::<ViewParams>(&module_for("view", shaders::VIEW));
 }
 
 fn inputs(lo: f32, hi: f32, n: usize, extremes: &[f32]) -> Vec<f32> {
@@ -78,15 +484,9 @@ fn inputs(lo: f32, hi: f32, n: usize, extremes: &[f32]) -> Vec<f32> {
 
 #[test]
 fn wgsl_special_functions_match_core_on_the_adapter() {
-    let ctx = match GpuContext::new_headless() {
-        Ok(c) => c,
-        Err(e) => {
-            // Never require a GPU: without any adapter (not even llvmpipe) this test has nothing to run on.
-            eprintln!("skipping GPU mirror test: {e}");
-            return;
-        }
+    let Some(ctx) = lodestone_tests::gpu("the GPU mirror test") else {
+        return;
     };
-    eprintln!("adapter: {}", ctx.describe());
     type Case = (&'static str, fn(f64) -> f64, fn(f32) -> f32, f32, f32);
     let cases: [Case; 7] = [
         ("erf", special::erf, special_f32::erf, -6.0, 6.0),

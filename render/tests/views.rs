@@ -3,32 +3,19 @@
 //! and cameras (near, grazing, far); the GPU ground truth agrees with core's CPU ray tracer.
 
 use glam::{DVec2, DVec3};
-use lodestone_core::camera::Camera;
-use lodestone_core::cylinder::Shape;
-use lodestone_core::footprint::{Config, Method, Prepared};
-use lodestone_core::material::Material;
-use lodestone_core::smith::direction;
-use lodestone_render::{GpuContext, GpuMaterial, Renderer, Scene, ViewMode};
-
-fn preset(name: &str) -> Material {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../presets")
-        .join(name);
-    Material::from_ron(&std::fs::read_to_string(path).unwrap()).unwrap()
-}
+use lodestone_core::eval::{Evaluator, FootprintQuery, Method};
+use lodestone_core::scene::camera::Camera;
+use lodestone_core::scene::direction::direction;
+use lodestone_core::scene::shape::Shape;
+use lodestone_render::{GpuMaterial, Renderer, Scene, ViewMode};
+use lodestone_tests::preset;
 
 fn renderer() -> Option<Renderer> {
-    match GpuContext::new_headless() {
-        Ok(ctx) => Some(Renderer::new(ctx)),
-        Err(e) => {
-            eprintln!("skipping GPU view test: {e}");
-            None
-        }
-    }
+    lodestone_tests::renderer("the GPU view test")
 }
 
 fn cpu_pixel(
-    p: &Prepared,
+    p: &Evaluator,
     scene: &Scene,
     mode: ViewMode,
     x: u32,
@@ -49,7 +36,7 @@ fn cpu_pixel(
 /// A distant, narrow camera: every pixel covers many features, so the GPU truth image's mean
 /// estimates the same stationary expectation as the CPU's far patch; they agree within 2% per
 /// channel at 0° and 60° from the normal.
-fn far_truth_matches_cpu(r: &Renderer, p: &Prepared, label: &str) {
+fn far_truth_matches_cpu(r: &Renderer, p: &Evaluator, label: &str) {
     for elevation in [0.0_f64, 60.0] {
         let camera = Camera {
             elevation_deg: elevation,
@@ -77,7 +64,7 @@ fn far_truth_matches_cpu(r: &Renderer, p: &Prepared, label: &str) {
             }
         }
         let cpu = p.ground_truth(
-            &Config::far(p, direction(elevation.to_radians(), 0.0), DVec3::Z),
+            &FootprintQuery::far(p, direction(elevation.to_radians(), 0.0), DVec3::Z),
             60_000,
             9,
         );
@@ -145,7 +132,7 @@ fn analytic_views_match_core_pixel_by_pixel() {
         "snow-under-sky.ron",
     ] {
         let m = preset(name);
-        let p = Prepared::new(&m).unwrap();
+        let p = Evaluator::new(&m).unwrap();
         for (cam_name, camera) in cameras {
             let scene = Scene {
                 camera,
@@ -192,10 +179,10 @@ fn analytic_views_match_core_pixel_by_pixel() {
 #[test]
 fn ground_truth_matches_the_cpu_ray_tracer_on_a_far_patch() {
     let Some(r) = renderer() else { return };
-    let p = Prepared::new(&preset("default.ron")).unwrap();
+    let p = Evaluator::new(&preset("default.ron")).unwrap();
     far_truth_matches_cpu(&r, &p, "default");
     // Slope colour, the colour-term combination and the sky's SH9 irradiance per micro-normal.
-    let p = Prepared::new(&preset("snow-under-sky.ron")).unwrap();
+    let p = Evaluator::new(&preset("snow-under-sky.ron")).unwrap();
     far_truth_matches_cpu(&r, &p, "snow under sky");
 }
 
@@ -213,7 +200,7 @@ fn cylinder_views_match_core() {
 /// tangent frame turns with the surface): snake-skin checks that the GPU turns them like core.
 fn cylinder_views_match_core_for(r: &Renderer, name: &str) {
     let m = preset(name);
-    let p = Prepared::new(&m).unwrap();
+    let p = Evaluator::new(&m).unwrap();
     let radius = 1.5;
     let camera = Camera {
         elevation_deg: 55.0,
@@ -272,7 +259,7 @@ fn cylinder_views_match_core_for(r: &Renderer, name: &str) {
     let img = r
         .render(&gm, &scene, ViewMode::Truth, (w, h), 16)
         .expect("readback");
-    let sigma = lodestone_core::camera::PIXEL_SIGMA;
+    let sigma = lodestone_core::scene::camera::PIXEL_SIGMA;
     let jitter: Vec<DVec2> = (0..16)
         .map(|k| {
             let (u1, u2) = (
@@ -325,7 +312,7 @@ fn cylinder_views_match_core_for(r: &Renderer, name: &str) {
 }
 
 /// A small, non-Gaussian, tiling test image: rounded cells (a max of cosines) with a ridge.
-fn test_image(n: usize) -> std::sync::Arc<lodestone_core::image_driver::ImageDriver> {
+fn test_image(n: usize) -> std::sync::Arc<lodestone_core::driver::image::ImageDriver> {
     use std::f64::consts::TAU;
     let values: Vec<f32> = (0..n * n)
         .map(|i| {
@@ -335,7 +322,7 @@ fn test_image(n: usize) -> std::sync::Arc<lodestone_core::image_driver::ImageDri
             (a * a * a + b) as f32
         })
         .collect();
-    std::sync::Arc::new(lodestone_core::image_driver::ImageDriver::new(n, n, &values).unwrap())
+    std::sync::Arc::new(lodestone_core::driver::image::ImageDriver::new(n, n, &values).unwrap())
 }
 
 /// An image driver: the analytic views equal core pixel by pixel (near, grazing, far), and the GPU
@@ -349,7 +336,7 @@ fn image_driver_views_match_core() {
         size: 0.8,
     };
     m.heights.sigma_h = 0.02;
-    let p = Prepared::with_image(&m, Some(test_image(64)), None).unwrap();
+    let p = Evaluator::with_image(&m, Some(test_image(64)), None).unwrap();
     let light = direction(0.7, 2.2);
     let (w, h) = (40, 28);
     for (cam_name, camera) in [

@@ -1,1 +1,80 @@
-//! Integration-test crate: the tests live in `tests/tests/`.
+//! Fixtures shared by Lodestone's integration tests (`tests/tests/`, `render/tests/`): the preset
+//! library with its driver images, and the GPU adapter that tests skip without.
+//!
+//! Never require a GPU: without any adapter (not even Mesa's llvmpipe) a GPU test has nothing to
+//! run on, so [`gpu`] and [`renderer`] say so on stderr and return `None`; CI installs llvmpipe so
+//! they run there.
+
+use lodestone_core::driver::image::ImageDriver;
+use lodestone_core::eval::Evaluator;
+use lodestone_core::material::{Driver, Material};
+use lodestone_render::{GpuContext, Renderer};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// The headless GPU context, or `None` (with "skipping {test}: why" on stderr) when there is no
+/// adapter.
+pub fn gpu(test: &str) -> Option<GpuContext> {
+    match GpuContext::new_headless() {
+        Ok(ctx) => {
+            eprintln!("{test} on {}", ctx.describe());
+            Some(ctx)
+        }
+        Err(e) => {
+            eprintln!("skipping {test}: {e}");
+            None
+        }
+    }
+}
+
+/// A renderer on [`gpu`], or `None` without an adapter.
+pub fn renderer(test: &str) -> Option<Renderer> {
+    gpu(test).map(Renderer::new)
+}
+
+/// The preset library folder, `presets/`.
+pub fn presets_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../presets")
+}
+
+/// A preset of the library by file name (`"default.ron"`), parsed.
+pub fn preset(name: &str) -> Material {
+    let path = presets_dir().join(name);
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    Material::from_ron(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// Every preset of the library: (path, RON text), sorted by path.
+pub fn presets() -> Vec<(String, String)> {
+    let mut out = vec![];
+    for entry in std::fs::read_dir(presets_dir()).expect("presets/ exists") {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "ron") {
+            out.push((
+                path.display().to_string(),
+                std::fs::read_to_string(&path).unwrap(),
+            ));
+        }
+    }
+    out.sort();
+    out
+}
+
+/// An evaluator for the preset at `path`, decoding its driver image (relative to the preset) when
+/// it has one.
+pub fn prepare(path: &str, m: &Material) -> Evaluator {
+    let image = match &m.driver {
+        Driver::Image { path: img, .. } => {
+            let file = std::path::Path::new(path).parent().unwrap().join(img);
+            let luma = image::open(&file)
+                .unwrap_or_else(|e| panic!("{path}: driver image {}: {e}", file.display()))
+                .to_luma32f();
+            let (w, h) = luma.dimensions();
+            Some(Arc::new(
+                ImageDriver::new(w as usize, h as usize, luma.as_raw()).unwrap(),
+            ))
+        }
+        Driver::Noise(_) => None,
+    };
+    Evaluator::with_image(m, image, None).unwrap_or_else(|e| panic!("{path}: {e}"))
+}

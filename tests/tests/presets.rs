@@ -1,12 +1,11 @@
 //! Every preset in presets/ loads, validates, round-trips (load → save → load gives an equal value),
 //! evaluates finite on the CPU and renders under every mode on the GPU adapter.
 
-use lodestone_core::footprint::Config;
+use lodestone_core::eval::FootprintQuery;
 use lodestone_core::material::Material;
-use lodestone_core::smith::direction;
+use lodestone_core::scene::direction::direction;
 
-mod common;
-use common::{prepare, presets};
+use lodestone_tests::{prepare, presets};
 
 #[test]
 fn every_preset_loads_validates_and_round_trips() {
@@ -30,7 +29,8 @@ fn every_preset_evaluates_finite() {
         let m = Material::from_ron(&text).unwrap();
         let p = prepare(&path, &m);
         for deg in [0.0_f64, 60.0, 89.0] {
-            let cfg = Config::far(&p, direction(deg.to_radians(), 0.2), direction(0.6, 2.0));
+            let cfg =
+                FootprintQuery::far(&p, direction(deg.to_radians(), 0.2), direction(0.6, 2.0));
             for v in [
                 p.naive(&cfg),
                 p.view_independent(&cfg),
@@ -56,17 +56,12 @@ fn default_preset_is_the_core_default() {
 /// and not black (each preset is lit from 40° and seen from 60°).
 #[test]
 fn every_preset_renders() {
-    use lodestone_core::camera::Camera;
-    use lodestone_core::cylinder::Shape;
-    use lodestone_render::{GpuContext, GpuMaterial, Renderer, Scene, ViewMode};
-    let ctx = match GpuContext::new_headless() {
-        Ok(c) => c,
-        Err(e) => {
-            eprintln!("skipping render test: {e}");
-            return;
-        }
+    use lodestone_core::scene::camera::Camera;
+    use lodestone_core::scene::shape::Shape;
+    use lodestone_render::{GpuMaterial, Scene, ViewMode};
+    let Some(r) = lodestone_tests::renderer("the render test") else {
+        return;
     };
-    let r = Renderer::new(ctx);
     let scene = Scene {
         camera: Camera {
             elevation_deg: 60.0,

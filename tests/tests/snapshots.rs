@@ -3,12 +3,12 @@
 //! in `tests/snapshots/`. Regenerate with `UPDATE_SNAPSHOTS=1 cargo test -p lodestone-tests --test snapshots`.
 
 use glam::DVec3;
-use lodestone_core::camera::Camera;
-use lodestone_core::cylinder::Shape;
-use lodestone_core::footprint::Prepared;
+use lodestone_core::eval::Evaluator;
 use lodestone_core::material::Material;
-use lodestone_core::smith::direction;
-use lodestone_render::{GpuContext, GpuMaterial, Renderer, Scene, ViewMode};
+use lodestone_core::scene::camera::Camera;
+use lodestone_core::scene::direction::direction;
+use lodestone_core::scene::shape::Shape;
+use lodestone_render::{GpuMaterial, Renderer, Scene, ViewMode};
 use std::path::PathBuf;
 
 const SIZE: (u32, u32) = (64, 40);
@@ -67,14 +67,9 @@ fn compare(name: &str, got: &image::RgbaImage) -> Result<(), String> {
 
 #[test]
 fn views_match_their_snapshots() {
-    let ctx = match GpuContext::new_headless() {
-        Ok(c) => c,
-        Err(e) => {
-            eprintln!("skipping snapshot test: {e}");
-            return;
-        }
+    let Some(ctx) = lodestone_tests::gpu("the snapshot test") else {
+        return;
     };
-    eprintln!("snapshots on {}", ctx.describe());
     let r = Renderer::new(ctx);
     let plane = Shape::Plane;
     let cylinder = Shape::Cylinder { radius: 1.2 };
@@ -129,7 +124,7 @@ fn views_match_their_snapshots() {
     for preset in ["default", "moss"] {
         let text = std::fs::read_to_string(root().join("../presets").join(format!("{preset}.ron")))
             .unwrap();
-        let prepared = Prepared::new(&Material::from_ron(&text).unwrap()).unwrap();
+        let prepared = Evaluator::new(&Material::from_ron(&text).unwrap()).unwrap();
         for (view, shape, camera) in views {
             if shape != plane && preset != "default" {
                 continue;

@@ -5,17 +5,15 @@
 //! (an exact plane hit where the all-features shader marches to a bisection tolerance). Measured on
 //! llvmpipe: 98 of 108 images identical, the worst 8.5e-5 of the peak on average.
 
-mod common;
-
-use common::{prepare, presets};
-use lodestone_core::camera::Camera;
-use lodestone_core::cylinder::Shape;
-use lodestone_core::features::{Feature, FeatureSet};
 use lodestone_core::material::Material;
-use lodestone_core::smith::direction;
+use lodestone_core::material::features::{Feature, FeatureSet};
+use lodestone_core::scene::camera::Camera;
+use lodestone_core::scene::direction::direction;
+use lodestone_core::scene::shape::Shape;
 use lodestone_render::renderer::material_data_for;
 use lodestone_render::specialize::{ShaderSize, view_source_for};
-use lodestone_render::{GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode};
+use lodestone_render::{GpuMaterial, LinearImage, Scene, ViewMode};
+use lodestone_tests::{prepare, presets};
 
 const SIZE: (u32, u32) = (40, 26);
 
@@ -40,14 +38,9 @@ fn difference(a: &LinearImage, b: &LinearImage) -> (f64, f64) {
 
 #[test]
 fn specialised_pipelines_render_what_the_all_features_pipeline_renders() {
-    let ctx = match GpuContext::new_headless() {
-        Ok(c) => c,
-        Err(e) => {
-            eprintln!("skipping specialisation test: {e}");
-            return;
-        }
+    let Some(r) = lodestone_tests::renderer("the specialisation test") else {
+        return;
     };
-    let r = Renderer::new(ctx);
     let camera = Camera {
         elevation_deg: 62.0,
         azimuth_deg: 25.0,

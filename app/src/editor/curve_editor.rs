@@ -3,8 +3,8 @@
 //! the resulting heights h = g(f), f ~ N(0, 1) [HNPN14 Sec. 7].
 
 use egui::{Color32, Pos2, Rect, Role, Sense, Stroke, Ui, Vec2, WidgetInfo};
-use lodestone_core::image_driver::ImageDriver;
-use lodestone_core::transfer::{Curve, CurveInterpolation, TransferFunction};
+use lodestone_core::driver::image::ImageDriver;
+use lodestone_core::material::transfer::{Curve, CurveInterpolation, TransferFunction};
 use std::sync::Arc;
 
 /// Persistent UI state (the selected point).
@@ -410,7 +410,7 @@ mod tests {
     }
 
     fn libm_erf(x: f64) -> f64 {
-        lodestone_core::special::erf(x)
+        lodestone_core::math::special::erf(x)
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //! the built-in maps.
 
 use egui::{Color32, Pos2, Rect, Role, Sense, Stroke, Ui, Vec2, WidgetInfo};
-use lodestone_core::colormap::{ColorStop, Gradient, Interpolation, linear_to_srgb};
+use lodestone_core::material::colormap::{ColorStop, Gradient, Interpolation, linear_to_srgb};
 
 /// Persistent UI state of the editor (which stop is selected).
 #[derive(Clone, Copy, Debug, Default)]

@@ -4,17 +4,17 @@
 use super::curve_editor::CurveEditor;
 use super::gradient_editor::GradientEditor;
 use egui::{Slider, Ui};
-use lodestone_core::color_terms::{CombineMode, ConstantTerm, SlopeTerm};
-use lodestone_core::colormap::Gradient;
-use lodestone_core::effective_height::HeightFilter;
-use lodestone_core::environment::{Environment, EnvironmentSource, Lighting, Sky};
-use lodestone_core::features::{Feature, FeatureSet};
-use lodestone_core::image_driver::ImageDriver;
+use lodestone_core::driver::image::ImageDriver;
+use lodestone_core::driver::noise::NoiseParams;
+use lodestone_core::material::color_terms::{CombineMode, ConstantTerm, SlopeTerm};
+use lodestone_core::material::colormap::Gradient;
+use lodestone_core::material::environment::{Environment, EnvironmentSource, Lighting, Sky};
+use lodestone_core::material::features::{Feature, FeatureSet};
+use lodestone_core::material::slope_color::SlopeColor;
+use lodestone_core::material::transfer::{SurfaceShape, TransferFunction};
 use lodestone_core::material::{ColorModel, ColorSource, Driver, Filtering, Material};
-use lodestone_core::noise::NoiseParams;
-use lodestone_core::shadowing::Correlation;
-use lodestone_core::slope_color::SlopeColor;
-use lodestone_core::transfer::{SurfaceShape, TransferFunction};
+use lodestone_core::microfacet::effective_height::HeightFilter;
+use lodestone_core::microfacet::masking_shadowing::Correlation;
 use std::sync::Arc;
 
 /// UI state of the inspector.

@@ -6,9 +6,9 @@
 use crate::preset_io::Resolved;
 use egui::Color32;
 use egui_plot::{Corner, Legend, Line, Plot, PlotPoints};
-use lodestone_core::footprint::Config;
+use lodestone_core::eval::FootprintQuery;
 use lodestone_core::material::Material;
-use lodestone_core::smith::direction;
+use lodestone_core::scene::direction::direction;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::mpsc::{Receiver, Sender};
@@ -58,7 +58,7 @@ pub fn compute(
                 return None;
             }
             let wo = direction(a.to_radians(), azimuth_deg.to_radians());
-            let cfg = Config::far(&p, wo, light);
+            let cfg = FootprintQuery::far(&p, wo, light);
             let gt = p.ground_truth(&cfg, TRUTH_SAMPLES, 7);
             Some(AnglePoint {
                 angle: a,

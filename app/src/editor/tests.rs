@@ -3,6 +3,7 @@
 
 use super::worker::DeviceSource;
 use super::*;
+use egui::{Key, Modifiers};
 use egui_kittest::kittest::Queryable;
 use egui_kittest::{Harness, SnapshotOptions};
 use std::time::{Duration, Instant};
@@ -63,7 +64,7 @@ fn loads_a_preset_and_edits_undo_redo() {
     h.state_mut().open_path(&ctx, &preset("moss.ron"));
     h.step();
     assert_eq!(h.state().material().name, "Moss clumps (transfer function)");
-    assert!(!h.state().dirty());
+    assert!(!h.state().doc.dirty());
 
     // Move σ_h with the slider.
     let before = h.state().material().heights.sigma_h;
@@ -73,7 +74,7 @@ fn loads_a_preset_and_edits_undo_redo() {
     h.step();
     let after = h.state().material().heights.sigma_h;
     assert!((after - 0.25).abs() < 1e-9, "σ_h = {after}");
-    assert!(h.state().dirty());
+    assert!(h.state().doc.dirty());
 
     // Undo and redo with the keyboard.
     h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
@@ -544,8 +545,8 @@ fn dropping_an_environment_map_sets_the_environment() {
     h.step();
     h.step();
     match &h.state().material().lighting.environment {
-        Some(lodestone_core::environment::Environment {
-            source: lodestone_core::environment::EnvironmentSource::File { path },
+        Some(lodestone_core::material::environment::Environment {
+            source: lodestone_core::material::environment::EnvironmentSource::File { path },
             intensity,
         }) => assert!(path.ends_with("studio.hdr") && *intensity == 1.0, "{path}"),
         other => panic!("expected a file environment, got {other:?}"),

@@ -1,9 +1,9 @@
 //! The state every viewport shares: one orbit camera, one directional light, the display options,
 //! and the zoom sweep animation.
 
-use lodestone_core::camera::Camera;
-use lodestone_core::cylinder::Shape;
-use lodestone_core::smith::direction;
+use lodestone_core::scene::camera::Camera;
+use lodestone_core::scene::direction::direction;
+use lodestone_core::scene::shape::Shape;
 use lodestone_render::{Scene, ViewMode};
 use serde::{Deserialize, Serialize};
 

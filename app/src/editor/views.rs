@@ -5,8 +5,8 @@ use super::gradient_editor::color32;
 use super::view_state::{DISTANCE_RANGE, Mode};
 use super::{DeviceStatus, EditorApp};
 use egui::{Color32, Pos2, Rect, Role, Sense, Stroke, Ui, Vec2, WidgetInfo};
-use lodestone_core::camera::Camera;
-use lodestone_core::cylinder::Shape;
+use lodestone_core::scene::camera::Camera;
+use lodestone_core::scene::shape::Shape;
 use lodestone_render::ViewMode;
 
 /// Width of the draggable gap between viewports.

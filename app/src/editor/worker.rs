@@ -12,10 +12,10 @@
 //!
 //! checking for a newer request between passes.
 
-use lodestone_core::footprint::Prepared;
-use lodestone_core::image_driver::ImageDriver;
+use lodestone_core::driver::image::ImageDriver;
+use lodestone_core::eval::Evaluator;
 use lodestone_core::material::Material;
-use lodestone_core::sh::Sh9;
+use lodestone_core::math::sh::Sh9;
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
 };
@@ -189,7 +189,7 @@ struct State {
     renderer: Renderer,
     material: Option<(Arc<Material>, GpuMaterial)>,
     /// The last prepared material (its tables are reused when their inputs did not change).
-    prepared: Option<Prepared>,
+    prepared: Option<Evaluator>,
     /// The environment radiance the prepared material was given.
     environment: Option<Sh9>,
     /// Seconds per pixel of each analytic mode, measured.
@@ -251,7 +251,7 @@ impl State {
         environment: &Option<Sh9>,
         send: &dyn Fn(Event),
     ) -> bool {
-        let same_image = |p: &Prepared| match (p.surface.driver.image(), image) {
+        let same_image = |p: &Evaluator| match (p.surface.driver.image(), image) {
             (None, None) => true,
             (Some(a), Some(b)) => Arc::ptr_eq(&a.image, b),
             _ => false,
@@ -263,7 +263,7 @@ impl State {
         {
             return true;
         }
-        match Prepared::with_image(material, image.clone(), self.prepared.as_ref()) {
+        match Evaluator::with_image(material, image.clone(), self.prepared.as_ref()) {
             Ok(mut p) => {
                 if let Some(sh) = environment {
                     p.set_environment_radiance(sh);
@@ -437,9 +437,9 @@ impl State {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use lodestone_core::camera::Camera;
-    use lodestone_core::cylinder::Shape;
-    use lodestone_core::smith::direction;
+    use lodestone_core::scene::camera::Camera;
+    use lodestone_core::scene::direction::direction;
+    use lodestone_core::scene::shape::Shape;
 
     fn request(generation: u64, spp: u32) -> Request {
         Request {

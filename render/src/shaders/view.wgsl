@@ -1,7 +1,8 @@
-// One view of the plane or cylinder scene: a compute pass over the image. Needs special.wgsl and material.wgsl
-// (and cylinder.wgsl for curved scenes: its branches are `//#if curved`, see specialize.rs).
-// Modes: 0 naive MIP, 1 view-independent filtering, 2 filtered, 3 ground truth (progressive: one
-// low-discrepancy, Gaussian-filtered sub-pixel ray per pixel per frame; alpha counts samples).
+// One view of the plane or cylinder scene: a compute pass over the image. Needs the special,
+// material and view-parameter units (and scene/cylinder.wgsl for curved scenes: its branches are
+// `//#if curved`, see specialize.rs). Modes (MODE_*): naive MIP, view-independent filtering,
+// filtered, ground truth (progressive: one low-discrepancy, Gaussian-filtered sub-pixel ray per
+// pixel per frame; alpha counts samples).
 
 @group(0) @binding(2) var<storage, read_write> accum: array<vec4<f32>>;
 
@@ -9,9 +10,9 @@ const PIXEL_SIGMA_DEFAULT: f32 = 0.5;
 
 // Camera::raw_dir (unnormalised), pixel coordinates with centres at +0.5.
 fn raw_dir(p: vec2<f32>) -> vec3<f32> {
-    let nx = (p.x / f32(params.width)) * 2.0 - 1.0;
-    let ny = 1.0 - (p.y / f32(params.height)) * 2.0;
-    return params.forward + params.right * (nx * params.tan_half_fov * params.aspect) + params.up * (ny * params.tan_half_fov);
+    let nx = (p.x / f32(view_params.width)) * 2.0 - 1.0;
+    let ny = 1.0 - (p.y / f32(view_params.height)) * 2.0;
+    return view_params.forward + view_params.right * (nx * view_params.tan_half_fov * view_params.aspect) + view_params.up * (ny * view_params.tan_half_fov);
 }
 
 // Camera::plane_footprint: (x0.x, x0.y) and covariance (xx, yy, xy); w = 0 marks the sky.
@@ -23,18 +24,18 @@ struct PlaneFootprint {
 
 fn plane_footprint(p: vec2<f32>) -> PlaneFootprint {
     var r: PlaneFootprint;
-    let e = params.eye;
+    let e = view_params.eye;
     let d = raw_dir(p);
     r.hit = d.z < 0.0;
     if (!r.hit) {
         return r;
     }
-    let dx = params.right * (2.0 * params.tan_half_fov * params.aspect / f32(params.width));
-    let dy = params.up * (-2.0 * params.tan_half_fov / f32(params.height));
+    let dx = view_params.right * (2.0 * view_params.tan_half_fov * view_params.aspect / f32(view_params.width));
+    let dy = view_params.up * (-2.0 * view_params.tan_half_fov / f32(view_params.height));
     let hit = e - d * (e.z / d.z);
     let jx = -(dx * d.z - d * dx.z) * (e.z / (d.z * d.z));
     let jy = -(dy * d.z - d * dy.z) * (e.z / (d.z * d.z));
-    let s2 = params.pixel_sigma * params.pixel_sigma;
+    let s2 = view_params.pixel_sigma * view_params.pixel_sigma;
     r.x0 = hit.xy;
     r.cov = vec3<f32>(jx.x * jx.x + jy.x * jy.x, jx.y * jx.y + jy.y * jy.y, jx.x * jx.y + jy.x * jy.y) * s2;
     return r;
@@ -50,28 +51,28 @@ fn pcg(v: u32) -> u32 {
 
 @compute @workgroup_size(8, 8)
 fn view_main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= params.width || gid.y >= params.height) {
+    if (gid.x >= view_params.width || gid.y >= view_params.height) {
         return;
     }
-    let idx = gid.y * params.width + gid.x;
+    let idx = gid.y * view_params.width + gid.x;
     let centre = vec2<f32>(f32(gid.x) + 0.5, f32(gid.y) + 0.5);
-    let wi = params.light;
+    let wi = view_params.light;
 //#if curved
-    if (params.shape == 1u) {
-        if (params.mode < 3u) {
-            let dx = params.right * (2.0 * params.tan_half_fov * params.aspect / f32(params.width));
-            let dy = params.up * (-2.0 * params.tan_half_fov / f32(params.height));
-            accum[idx] = vec4<f32>(cylinder_pixel(params.mode, raw_dir(centre), dx, dy, wi), 1.0);
+    if (view_params.shape == SHAPE_CYLINDER) {
+        if (view_params.mode < MODE_TRUTH) {
+            let dx = view_params.right * (2.0 * view_params.tan_half_fov * view_params.aspect / f32(view_params.width));
+            let dy = view_params.up * (-2.0 * view_params.tan_half_fov / f32(view_params.height));
+            accum[idx] = vec4<f32>(cylinder_pixel(view_params.mode, raw_dir(centre), dx, dy, wi), 1.0);
             return;
         }
-    } else if (params.mode < 3u) {
+    } else if (view_params.mode < MODE_TRUTH) {
 //#else
-    if (params.mode < 3u) {
+    if (view_params.mode < MODE_TRUTH) {
 //#endif
         let fp = plane_footprint(centre);
         var c = vec3<f32>(0.0);
         if (fp.hit) {
-            c = analytic_pixel(params.mode, params.eye, normalize(raw_dir(centre)), wi, fp.cov);
+            c = analytic_pixel(view_params.mode, view_params.eye, normalize(raw_dir(centre)), wi, fp.cov);
         }
         accum[idx] = vec4<f32>(c, 1.0);
         return;
@@ -80,23 +81,23 @@ fn view_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     // golden-ratio generalisation), Cranley–Patterson rotated per pixel, mapped through Box–Muller
     // onto the Gaussian pixel filter. Every prefix of the sequence is evenly spread, so progressive
     // images are unbiased at any sample count.
-    let s = params.frame;
+    let s = view_params.frame;
     let r1 = s * 3242174889u + pcg(idx * 2u + 1u);
     let r2 = s * 2447445413u + pcg(idx * 2u + 2u);
     let u1 = (f32(r1 >> 8u) + 0.5) * (1.0 / 16777216.0);
     let u2 = (f32(r2 >> 8u) + 0.5) * (1.0 / 16777216.0);
-    let rad = sqrt(-2.0 * log(u1)) * params.pixel_sigma;
+    let rad = sqrt(-2.0 * log(u1)) * view_params.pixel_sigma;
     let off = vec2<f32>(rad * cos(TAU * u2), rad * sin(TAU * u2));
     let d = normalize(raw_dir(centre + off));
     var c: vec3<f32>;
 //#if curved
-    if (params.shape == 1u) {
-        c = cylinder_trace_ray(params.eye, d, wi);
+    if (view_params.shape == SHAPE_CYLINDER) {
+        c = cylinder_trace_ray(view_params.eye, d, wi);
     } else {
-        c = trace_ray(params.eye, d, wi);
+        c = trace_ray(view_params.eye, d, wi);
     }
 //#else
-    c = trace_ray(params.eye, d, wi);
+    c = trace_ray(view_params.eye, d, wi);
 //#endif
     let prev = select(vec4<f32>(0.0), accum[idx], s > 0u);
     accum[idx] = prev + vec4<f32>(c, 1.0);

@@ -1,0 +1,127 @@
+//! Ground truth: eye rays through points drawn from the footprint's weight `w_P`, marched onto the
+//! explicit surface ([`crate::scene::surface::Surface::march`]), shaded with the base BRDF at the
+//! true micro-normal, with a real shadow ray. No Smith, no Λ: it never uses the statistical model
+//! it judges. Reported with its standard error.
+
+use crate::eval::{Estimate, Evaluator, FootprintQuery};
+use crate::math::gaussian::cholesky;
+use crate::math::random::standard_normal;
+use crate::microfacet::slopes::SlopeCov;
+use crate::microfacet::slopes::normal_of;
+use crate::scene::surface::Trace;
+use glam::{DMat3, DVec2, DVec3};
+use rayon::prelude::*;
+
+impl Evaluator {
+    /// Ground truth by ray tracing the explicit surface with `samples` eye rays drawn from the
+    /// footprint (deterministic for a given seed; parallel).
+    pub fn ground_truth(&self, cfg: &FootprintQuery, samples: usize, seed: u64) -> Estimate {
+        let samples = samples.max(2);
+        if cfg.wo.z <= 0.0 {
+            return Estimate {
+                mean: [0.0; 3],
+                std_error: [0.0; 3],
+                samples,
+            };
+        }
+        let chol = cholesky(
+            cfg.footprint.cov.x_axis.x,
+            cfg.footprint.cov.x_axis.y,
+            cfg.footprint.cov.y_axis.y,
+        );
+        let chunk = 256;
+        let chunks = samples.div_ceil(chunk);
+        let (sum, sum2) = (0..chunks)
+            .into_par_iter()
+            .map(|c| {
+                let mut rng =
+                    seed ^ (c as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ 0xA076_1D64_78BD_642F;
+                let mut s = [0.0; 3];
+                let mut s2 = [0.0; 3];
+                for _ in 0..chunk.min(samples - c * chunk) {
+                    let z = DVec2::new(standard_normal(&mut rng), standard_normal(&mut rng));
+                    let y = cfg.x0 + DVec2::new(chol.0 * z.x, chol.1 * z.x + chol.2 * z.y);
+                    let v = self.trace_pixel_sample(y, cfg);
+                    for k in 0..3 {
+                        s[k] += v[k];
+                        s2[k] += v[k] * v[k];
+                    }
+                }
+                (s, s2)
+            })
+            .reduce(
+                || ([0.0; 3], [0.0; 3]),
+                |a, b| {
+                    (
+                        [0, 1, 2].map(|k| a.0[k] + b.0[k]),
+                        [0, 1, 2].map(|k| a.1[k] + b.1[k]),
+                    )
+                },
+            );
+        let n = samples as f64;
+        let mean = sum.map(|v| v / n);
+        let std_error =
+            [0, 1, 2].map(|k| ((sum2[k] / n - mean[k] * mean[k]).max(0.0) / (n - 1.0)).sqrt());
+        Estimate {
+            mean,
+            std_error,
+            samples,
+        }
+    }
+
+    /// One eye ray through the mean-plane point y: its radiance.
+    fn trace_pixel_sample(&self, y: DVec2, cfg: &FootprintQuery) -> [f64; 3] {
+        // Start above the slab: z = h_max·1.001 + margin, on the eye ray through (y, 0).
+        let lift = (self.surface.h_max * 1.001 + 1e-6) / cfg.wo.z + 1.0;
+        let origin = DVec3::new(y.x, y.y, 0.0) + cfg.wo * lift;
+        self.trace_ray(origin, -cfg.wo, cfg.wi)
+    }
+
+    /// Radiance along a camera ray (origin, unit direction) toward light ωi: the ray starts on the
+    /// top of the surface's slab, is marched onto the explicit surface, shaded with the base BRDF at
+    /// the true micro-normal, and lit only if a real shadow ray reaches the light.
+    pub fn trace_ray(&self, origin: DVec3, dir: DVec3, wi: DVec3) -> [f64; 3] {
+        if dir.z >= 0.0 {
+            return [0.0; 3];
+        }
+        let s = &self.surface;
+        let top = s.h_max * 1.001 + 1e-6;
+        let t0 = ((origin.z - top) / -dir.z).max(0.0);
+        let o = origin + dir * t0;
+        let Trace::Hit(t) = s.march(o, dir) else {
+            return [0.0; 3];
+        };
+        let p = o + dir * t;
+        let (f, _h, grad) = s.sample(DVec2::new(p.x, p.y));
+        let n = normal_of(grad);
+        self.shade_hit(f, n, -dir, wi, &DMat3::IDENTITY, || s.sees(p, wi))
+    }
+
+    /// Radiance of an explicit surface point with driver value f and unit micro-normal n (local
+    /// frame, as ωo and ωi; `frame` to the world), `sees_light` the shadow ray (cast only when the
+    /// directional light can contribute): the base BRDF under the directional light, plus the
+    /// environment's irradiance at the micro-normal (unshadowed, see [`crate::material::environment`]).
+    pub(crate) fn shade_hit(
+        &self,
+        f: f64,
+        n: DVec3,
+        wo: DVec3,
+        wi: DVec3,
+        frame: &DMat3,
+        sees_light: impl FnOnce() -> bool,
+    ) -> [f64; 3] {
+        // (Below the plane's horizon the plane's shadow ray fails; the cylinder's local light may
+        // be below its tangent plane and still reach a facet.)
+        let lit = n.dot(wi) > 0.0 && self.material.lighting.sun > 0.0;
+        if !lit && self.environment.is_none() {
+            return [0.0; 3];
+        }
+        let v = if lit && sees_light() { 1.0 } else { 0.0 };
+        let aff = self.material.terms.affine(self.color_at(f));
+        let spec = self
+            .material
+            .brdf
+            .specular_with(n, wo, wi, SlopeCov::default());
+        self.radiance(aff, aff, &self.point_shading(n, wi, frame), v, spec)
+    }
+}

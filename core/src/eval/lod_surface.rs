@@ -1,0 +1,39 @@
+//! The level-of-detail surface the analytic views meet: the footprint-filtered height h̄ (the
+//! noise's attenuated waves, or the image's pyramid, through the transfer function's mean), marched
+//! with a rigorous rate bound.
+
+use crate::driver::footprint::Footprint;
+use crate::eval::Evaluator;
+use crate::scene::surface::march_heightfield;
+use glam::{DVec2, DVec3};
+
+impl Evaluator {
+    /// h̄(x) for footprint `fp` (σ_f is phase-averaged, hence constant over x).
+    pub fn lod_height(&self, x: DVec2, fp: Footprint) -> f64 {
+        let (m, s) = self.surface.driver.lod_moments(x, fp);
+        self.surface.sigma_h * self.transfer.moments(m, s).mean
+    }
+
+    /// Rate bound of the gap along d: `|d_z| + K|d_xy|`, with K = σ_h·max|g′|·L̄(d̂) and L̄ the
+    /// Lipschitz constant of f̄ ([`DriverField::lod_lipschitz_along`]: for the noise the attenuated
+    /// components `Σ|a_i| g_i 2π|k_i·d̂|`; ∂ḡ/∂m = E[g′] ≤ max|g′|).
+    fn lod_rate(&self, d: DVec3, fp: Footprint) -> f64 {
+        let dxy = DVec2::new(d.x, d.y);
+        let r = dxy.length();
+        let mut k = 0.0;
+        if r > 0.0 {
+            k = self.surface.driver.lod_lipschitz_along(dxy / r, fp)
+                * self.surface.sigma_h
+                * self.surface.g_lip;
+        }
+        d.z.abs() + k * r
+    }
+
+    /// March `o + t·d` against h̄ (the same [`march_heightfield`] as the explicit surface).
+    pub fn lod_march(&self, o: DVec3, d: DVec3, fp: Footprint) -> Option<f64> {
+        let s = &self.surface;
+        march_heightfield(o, d, self.lod_rate(d, fp), s.h_max, s.min_step, |x| {
+            self.lod_height(x, fp)
+        })
+    }
+}

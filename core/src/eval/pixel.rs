@@ -1,0 +1,80 @@
+//! One pixel of an analytic view: the camera ray meets the level-of-detail surface, the method is
+//! evaluated there with the pixel's footprint, and a real shadow ray on h̄ decides the sun.
+
+use crate::driver::footprint::Footprint;
+use crate::eval::{Evaluator, FootprintQuery, Method};
+use crate::scene::camera::Camera;
+use glam::{DMat3, DVec2, DVec3};
+
+impl Evaluator {
+    /// One pixel of an analytic view: the camera ray (origin, unit dir) meets the level-of-detail
+    /// surface; the method is evaluated there with the pixel's footprint `fp`, and the result is 0 where
+    /// the resolved geometry shadows the light (a real shadow ray on h̄).
+    pub fn pixel(
+        &self,
+        method: Method,
+        origin: DVec3,
+        dir: DVec3,
+        wi: DVec3,
+        fp: Footprint,
+    ) -> [f64; 3] {
+        self.pixel_in_frame(method, origin, dir, wi, fp, &DMat3::IDENTITY)
+    }
+
+    /// [`Evaluator::pixel`] in a tangent frame whose axes in the world are `frame`'s columns (the
+    /// cylinder's): slope colour and environment are looked up at world normals.
+    pub fn pixel_in_frame(
+        &self,
+        method: Method,
+        origin: DVec3,
+        dir: DVec3,
+        wi: DVec3,
+        fp: Footprint,
+        frame: &DMat3,
+    ) -> [f64; 3] {
+        if dir.z >= 0.0 {
+            return [0.0; 3];
+        }
+        let top = self.surface.h_max * 1.001 + 1e-6;
+        let t0 = ((origin.z - top) / -dir.z).max(0.0);
+        let o = origin + dir * t0;
+        let Some(t) = self.lod_march(o, dir, fp) else {
+            return [0.0; 3];
+        };
+        let p = o + dir * t;
+        let sun_visible = wi.z > 0.0 && self.lod_march(p, wi, fp).is_none();
+        if !sun_visible && self.environment.is_none() {
+            return [0.0; 3];
+        }
+        let cfg = FootprintQuery {
+            wo: -dir,
+            wi,
+            x0: DVec2::new(p.x, p.y),
+            footprint: fp,
+        };
+        let v = if sun_visible { 1.0 } else { 0.0 };
+        match method {
+            Method::Naive => self.naive_lit(&cfg, v, frame),
+            Method::ViewIndependent => self.view_independent_lit(&cfg, v, frame),
+            Method::Filtered => self.filtered_lit(&cfg, v, frame),
+        }
+    }
+
+    /// One pixel of an analytic view of the plane: pixel centre `p` of a `width × height` image of
+    /// `camera`, its footprint on the mean plane, then [`Evaluator::pixel`] (0 for sky pixels). The
+    /// plane's counterpart of [`Evaluator::cylinder_pixel`].
+    pub fn plane_pixel(
+        &self,
+        method: Method,
+        camera: &Camera,
+        p: DVec2,
+        (width, height): (u32, u32),
+        wi: DVec3,
+    ) -> [f64; 3] {
+        let Some((_, cov)) = camera.plane_footprint(p, width, height) else {
+            return [0.0; 3];
+        };
+        let ray = camera.ray(p, width, height);
+        self.pixel(method, ray.origin, ray.dir, wi, Footprint { cov })
+    }
+}

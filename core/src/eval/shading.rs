@@ -1,0 +1,112 @@
+//! The shading inputs every method shares: per facet, or averaged over the visible slope
+//! distribution D_s [HNPN14 Sec. 5.2], and the radiance they give with the combined colour
+//! [HNPN14 Sec. 6] under the directional light and the environment [HNPN14 Sec. 5.3].
+
+use crate::eval::Evaluator;
+use crate::material::color_terms::Affine;
+use crate::microfacet::slopes::SlopeCov;
+use crate::microfacet::visible_slopes::visible_slope_nodes;
+use glam::{DMat3, DVec2, DVec3};
+use std::f64::consts::FRAC_1_PI;
+
+/// Shading inputs of a facet, or their average over a slope distribution: `E[(n·ωi)⁺]`,
+/// `E[C_s(n)(n·ωi)⁺]`, `E[E_env(n)]` and `E[C_s(n) ⊙ E_env(n)]`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SlopeShading {
+    /// `E[(n·ωi)⁺]`.
+    pub cos: f64,
+    /// `E[C_s(n)(n·ωi)⁺]`.
+    pub cs_cos: [f64; 3],
+    /// `E[E_env(n)]`.
+    pub env: [f64; 3],
+    /// `E[C_s(n) ⊙ E_env(n)]`.
+    pub cs_env: [f64; 3],
+}
+
+impl Evaluator {
+    /// `C_s(n)` of the slope term (0 without one).
+    pub(super) fn slope_color_at(&self, n: DVec3) -> [f64; 3] {
+        self.slope_color.as_ref().map_or([0.0; 3], |c| c.sample(n))
+    }
+
+    /// Environment irradiance at unit normal n (0 without an environment).
+    pub(super) fn environment_at(&self, n: DVec3) -> [f64; 3] {
+        self.environment
+            .as_ref()
+            .map_or([0.0; 3], |e| e.irradiance(n))
+    }
+
+    /// [`SlopeShading`] of one facet of unit normal n (in the local tangent frame, where ωi is;
+    /// `frame` takes it to the world, where the slope colour's direction and the environment are).
+    pub(super) fn point_shading(&self, n: DVec3, wi: DVec3, frame: &DMat3) -> SlopeShading {
+        let cos = n.dot(wi).max(0.0);
+        let nw = *frame * n;
+        let cs = self.slope_color_at(nw);
+        let env = self.environment_at(nw);
+        SlopeShading {
+            cos,
+            cs_cos: cs.map(|v| v * cos),
+            env,
+            cs_env: [0, 1, 2].map(|c| cs[c] * env[c]),
+        }
+    }
+
+    /// [`SlopeShading`] averaged over the visible slope distribution D_s(ωo) of slopes N(mean, Σ)
+    /// (world slope space) on the material's weighted polar nodes ([`visible_slope_nodes`], [`crate::microfacet::visible_slopes::slope_rule`]):
+    /// C_s and the environment are averaged *jointly* with the clamped cosine, so no independence of
+    /// colour and shading is assumed ([HNPN14 Sec. 5.2] assumes it; the joint average costs the same).
+    pub(super) fn visible_shading(
+        &self,
+        mean: DVec2,
+        sigma: &SlopeCov,
+        wo: DVec3,
+        wi: DVec3,
+        frame: &DMat3,
+    ) -> SlopeShading {
+        let mut acc = SlopeShading::default();
+        let points = self.material.filtering.slope_points as usize;
+        let den = visible_slope_nodes(mean, sigma, wo, points, |n, w| {
+            let p = self.point_shading(n, wi, frame);
+            acc.cos += w * p.cos;
+            for c in 0..3 {
+                acc.cs_cos[c] += w * p.cs_cos[c];
+                acc.env[c] += w * p.env[c];
+                acc.cs_env[c] += w * p.cs_env[c];
+            }
+        });
+        if den > 0.0 {
+            let inv = 1.0 / den;
+            acc.cos *= inv;
+            for c in 0..3 {
+                acc.cs_cos[c] *= inv;
+                acc.env[c] *= inv;
+                acc.cs_env[c] *= inv;
+            }
+            acc
+        } else {
+            SlopeShading::default()
+        }
+    }
+
+    /// Radiance from the combined colour `A + K ⊙ C_s` (`sun_color` under the directional light,
+    /// `env_color` under the environment, which can differ because D_h differs), the shading inputs,
+    /// the directional light's visibility `v` (shadowing) and the uncoloured specular:
+    /// `ρ_d/π·(sun·v·(A⊙E[cos] + K⊙E[C_s cos]) + A⊙E[E_env] + K⊙E[C_s⊙E_env]) + sun·v·spec`.
+    pub(super) fn radiance(
+        &self,
+        sun_color: Affine,
+        env_color: Affine,
+        s: &SlopeShading,
+        v: f64,
+        spec: f64,
+    ) -> [f64; 3] {
+        let sun = self.material.lighting.sun * v;
+        let kd = self.material.brdf.albedo * FRAC_1_PI;
+        [0, 1, 2].map(|c| {
+            kd * (sun * (sun_color.a[c] * s.cos + sun_color.k[c] * s.cs_cos[c])
+                + env_color.a[c] * s.env[c]
+                + env_color.k[c] * s.cs_env[c])
+                + sun * spec
+        })
+    }
+}

@@ -1,0 +1,38 @@
+//! Materials shared by the evaluation tests.
+
+use crate::material::Material;
+
+use crate::driver::noise::NoiseParams;
+use crate::material::colormap::Gradient;
+use crate::material::transfer::TransferFunction;
+use crate::material::{ColorModel, ColorSource, Heights, Slopes};
+use crate::microfacet::brdf::BaseBrdf;
+
+/// A Gaussian, height-correlated material: identity transfer, colour map of the driver (= height).
+pub(crate) fn gaussian_material() -> Material {
+    Material {
+        name: "test: Gaussian height-correlated".into(),
+        driver: crate::material::Driver::Noise(NoiseParams {
+            components: 32,
+            ..NoiseParams::default()
+        }),
+        heights: Heights {
+            sigma_h: 0.1,
+            transfer: TransferFunction::Identity,
+        },
+        slopes: Slopes {
+            sigma_nx: 0.5,
+            sigma_ny: 0.5,
+        },
+        color: ColorModel::Gradient {
+            map: Gradient::rust(-2.0, 2.0),
+            source: ColorSource::Driver,
+        },
+        brdf: BaseBrdf {
+            albedo: 1.0,
+            specular: 0.0,
+            roughness: 0.1,
+        },
+        ..Material::default()
+    }
+}

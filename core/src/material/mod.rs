@@ -1,0 +1,450 @@
+//! The material model: one serde type holding the driver, colour model, height transfer function,
+//! microsurface statistics (σ_h, σ_nx, σ_ny), base BRDF and filtering options, with validation that
+//! reports every invalid field at once.
+//!
+//! Conventions. The driver f has zero mean and unit variance. Heights are `h = σ_h·g(f)`; for the
+//! identity transfer function the surface has height std σ_h and slope std σ_nx, σ_ny exactly (the
+//! noise's frequencies are set from σ_n/σ_h, see [`crate::driver::noise`]). With a curve g, σ_h and σ_n set
+//! the scale of the driver before g, and the surface's statistics follow from [HNPN14 Eqs. 19–26].
+//!
+//! The parts, one module each: the colour map and its pre-convolved tables ([`colormap`],
+//! [`preconvolved`]), transfer functions ([`transfer`]), the colour terms and slope colour of
+//! [HNPN14 Sec. 6] ([`color_terms`], [`slope_color`]), the preview lighting ([`environment`]),
+//! validation messages ([`validation`]) and the feature set a material needs in a scene
+//! ([`features`]).
+
+pub mod color_terms;
+pub mod colormap;
+pub mod environment;
+pub mod features;
+pub mod preconvolved;
+pub mod slope_color;
+pub mod transfer;
+pub mod validation;
+
+use crate::driver::noise::{NoiseParams, SumOfSines};
+use crate::material::color_terms::ColorTerms;
+use crate::material::colormap::Gradient;
+use crate::material::environment::Lighting;
+use crate::material::preconvolved::TableSpec;
+use crate::material::transfer::TransferFunction;
+use crate::material::validation::{Problem, Problems};
+use crate::microfacet::brdf::BaseBrdf;
+use crate::microfacet::effective_height::HeightFilter;
+use crate::microfacet::masking_shadowing::Correlation;
+use crate::microfacet::slopes::SlopeCov;
+use serde::{Deserialize, Serialize};
+
+/// Current preset format version.
+pub const MATERIAL_VERSION: u32 = 1;
+
+/// Upper bound of σ_h, σ_n and roughness accepted from a preset (the UI range).
+pub const MAX_SIGMA: f64 = 1e6;
+
+/// The driving function f.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Driver {
+    /// Sum-of-sinusoids noise with analytic footprint statistics.
+    Noise(NoiseParams),
+    /// A grayscale image, tiled over `size` world units; loaded by the application.
+    Image {
+        /// Path of the image, relative to the preset file.
+        path: String,
+        /// World size of one tile of the image.
+        size: f64,
+    },
+}
+
+/// What a gradient colour map is indexed by.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
+pub enum ColorSource {
+    /// The driver value f ([HNPN14 Sec. 4]; height-correlated when σ_h > 0 and g is the identity).
+    #[default]
+    Driver,
+    /// The standardized height `(h − h̄)/std(h)` of the surface [HNPN14 Secs. 5.1, 7].
+    Height,
+}
+
+/// How the surface is coloured.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum ColorModel {
+    /// A gradient colour map [HNPN14 Secs. 4, 5.1].
+    Gradient {
+        /// The map.
+        map: Gradient,
+        /// Its input.
+        #[serde(default)]
+        source: ColorSource,
+    },
+    /// The HN12 attribute model per channel: `a(h) = ā + a_s·(2P(h) − 1)` [HN12 Eq. 17].
+    Attribute {
+        /// ā per linear-RGB channel.
+        mean: [f64; 3],
+        /// a_s per channel (correlation with height; may exceed ±ā, the result is then clamped at 0).
+        correlation: [f64; 3],
+    },
+}
+
+/// Height statistics and transfer function.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Heights {
+    /// σ_h: height standard deviation (world units), ≥ 0.
+    pub sigma_h: f64,
+    /// The height transfer function g [HNPN14 Sec. 7].
+    #[serde(default)]
+    pub transfer: TransferFunction,
+}
+
+/// Slope statistics σ_nx, σ_ny [HN12 Sec. 3].
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Slopes {
+    /// Slope standard deviation along x, ≥ 0.
+    pub sigma_nx: f64,
+    /// Slope standard deviation along y, ≥ 0.
+    pub sigma_ny: f64,
+}
+
+/// Filtering options of the filtered view.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Filtering {
+    /// Masking–shadowing combination (correlated by default).
+    pub correlation: Correlation,
+    /// Effective height moments: exact table (default) or the paper's fits.
+    pub height_filter: HeightFilter,
+    /// Size and σ range of the pre-convolved tables.
+    pub table: TableSpec,
+    /// n of the polar rule ([`crate::microfacet::visible_slopes::slope_rule`]: n radii × n angles) for averages over
+    /// the visible slope distribution D_s
+    /// (the GPU evaluates n² points per pixel).
+    pub slope_points: u32,
+}
+
+impl Default for Filtering {
+    fn default() -> Self {
+        Self {
+            correlation: Correlation::default(),
+            height_filter: HeightFilter::default(),
+            table: TableSpec::default(),
+            slope_points: Self::DEFAULT_SLOPE_POINTS,
+        }
+    }
+}
+
+impl Filtering {
+    /// Default n (64 nodes).
+    pub const DEFAULT_SLOPE_POINTS: u32 = 8;
+    /// Largest accepted order.
+    pub const MAX_SLOPE_POINTS: u32 = 32;
+}
+
+/// A material.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// Preset format version ([`MATERIAL_VERSION`]).
+    pub version: u32,
+    /// Display name.
+    pub name: String,
+    /// The driving function.
+    pub driver: Driver,
+    /// Heights.
+    pub heights: Heights,
+    /// Slopes.
+    pub slopes: Slopes,
+    /// Colour: the height- or driver-correlated colour model C_h.
+    pub color: ColorModel,
+    /// Which colour terms (constant C0, the colour model C_h, slope colour C_s) combine, and how
+    /// [HNPN14 Sec. 6]. Default: the colour model alone.
+    #[serde(default)]
+    pub terms: ColorTerms,
+    /// Base BRDF.
+    #[serde(default)]
+    pub brdf: BaseBrdf,
+    /// Filtering options.
+    #[serde(default)]
+    pub filtering: Filtering,
+    /// The preview lighting saved with the material: directional light scale and environment.
+    #[serde(default)]
+    pub lighting: Lighting,
+}
+
+/// Errors reading a material.
+#[derive(Debug, thiserror::Error)]
+pub enum MaterialError {
+    /// The text is not valid RON for a material.
+    #[error("line {line}, column {column}: {message}")]
+    Parse {
+        /// 1-based line.
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// What the parser says.
+        message: String,
+    },
+    /// The preset was written by a newer Lodestone.
+    #[error(
+        "preset version {found} is newer than this Lodestone understands ({supported}); update Lodestone"
+    )]
+    TooNew {
+        /// Version in the file.
+        found: u32,
+        /// Newest supported.
+        supported: u32,
+    },
+    /// Values parse but are invalid; every problem is listed.
+    #[error("invalid material:\n{}", .0.iter().map(|p| format!("  - {p}")).collect::<Vec<_>>().join("\n"))]
+    Invalid(Vec<Problem>),
+}
+
+impl Default for Material {
+    /// The default preset: colour-mapped Gaussian heights, rust in the crevices.
+    fn default() -> Self {
+        Self {
+            version: MATERIAL_VERSION,
+            name: "Rusty bumps".into(),
+            driver: Driver::Noise(NoiseParams::default()),
+            heights: Heights {
+                sigma_h: 0.05,
+                transfer: TransferFunction::Identity,
+            },
+            slopes: Slopes {
+                sigma_nx: 0.35,
+                sigma_ny: 0.35,
+            },
+            color: ColorModel::Gradient {
+                map: Gradient::rust(-2.0, 2.0),
+                source: ColorSource::Driver,
+            },
+            brdf: BaseBrdf {
+                albedo: 1.0,
+                specular: 0.04,
+                roughness: 0.15,
+            },
+            filtering: Filtering::default(),
+            terms: ColorTerms::default(),
+            lighting: Lighting::default(),
+        }
+    }
+}
+
+impl Material {
+    /// Parse RON, then validate. Errors carry line and column where the parser has them.
+    pub fn from_ron(text: &str) -> Result<Self, MaterialError> {
+        let options = ron::Options::default();
+        let m: Self = options.from_str(text).map_err(|e| MaterialError::Parse {
+            line: e.position.line,
+            column: e.position.col,
+            message: e.code.to_string(),
+        })?;
+        if m.version > MATERIAL_VERSION {
+            return Err(MaterialError::TooNew {
+                found: m.version,
+                supported: MATERIAL_VERSION,
+            });
+        }
+        m.validate().map_err(MaterialError::Invalid)?;
+        Ok(m)
+    }
+
+    /// Pretty RON.
+    pub fn to_ron(&self) -> String {
+        let cfg = ron::ser::PrettyConfig::new()
+            .depth_limit(6)
+            .struct_names(true);
+        ron::ser::to_string_pretty(self, cfg)
+            .unwrap_or_else(|e| format!("// serialisation failed: {e}"))
+    }
+
+    /// Every invalid field at once (empty = valid).
+    pub fn validate(&self) -> Result<(), Vec<Problem>> {
+        let mut p = Problems::default();
+        if self.version == 0 {
+            p.push("version", "must be at least 1");
+        }
+        match &self.driver {
+            Driver::Noise(n) => {
+                if n.components == 0 || n.components > NoiseParams::MAX_COMPONENTS {
+                    p.push(
+                        "driver.components",
+                        format!(
+                            "must be in 1..={}, got {}",
+                            NoiseParams::MAX_COMPONENTS,
+                            n.components
+                        ),
+                    );
+                }
+                if n.octaves == 0 || n.octaves > 12 {
+                    p.push(
+                        "driver.octaves",
+                        format!("must be in 1..=12, got {}", n.octaves),
+                    );
+                }
+                p.in_range("driver.gain", n.gain, 0.0, 4.0);
+                p.in_range("driver.bandwidth", n.bandwidth, 0.0, 1.5);
+                p.in_range("driver.frequency", n.frequency, 1e-6, 1e6);
+            }
+            Driver::Image { path, size } => {
+                if path.trim().is_empty() {
+                    p.push("driver.path", "an image driver needs a file path");
+                }
+                p.in_range("driver.size", *size, 1e-6, 1e6);
+            }
+        }
+        p.in_range("heights.sigma_h", self.heights.sigma_h, 0.0, MAX_SIGMA);
+        if let TransferFunction::Curve(c) = &self.heights.transfer {
+            c.validate("heights.transfer", &mut p);
+        }
+        p.in_range("slopes.sigma_nx", self.slopes.sigma_nx, 0.0, MAX_SIGMA);
+        p.in_range("slopes.sigma_ny", self.slopes.sigma_ny, 0.0, MAX_SIGMA);
+        match &self.color {
+            ColorModel::Gradient { map, .. } => map.validate("color.map", &mut p),
+            ColorModel::Attribute { mean, correlation } => {
+                for c in 0..3 {
+                    p.in_range(&format!("color.mean[{c}]"), mean[c], 0.0, 1e3);
+                    p.in_range(
+                        &format!("color.correlation[{c}]"),
+                        correlation[c],
+                        -1e3,
+                        1e3,
+                    );
+                }
+            }
+        }
+        self.terms.validate(&mut p);
+        self.lighting.validate(&mut p);
+        p.in_range("brdf.albedo", self.brdf.albedo, 0.0, 1.0);
+        p.in_range("brdf.specular", self.brdf.specular, 0.0, 1.0);
+        p.in_range("brdf.roughness", self.brdf.roughness, 0.0, MAX_SIGMA);
+        let t = self.filtering.table;
+        for (name, v) in [("size_m", t.size_m), ("size_sigma", t.size_sigma)] {
+            if !(2..=TableSpec::MAX_SIZE).contains(&v) {
+                p.push(
+                    format!("filtering.table.{name}"),
+                    format!("must be in 2..={}, got {v}", TableSpec::MAX_SIZE),
+                );
+            }
+        }
+        p.in_range("filtering.table.sigma_max", t.sigma_max, 1e-3, 100.0);
+        let sp = self.filtering.slope_points;
+        if !(1..=Filtering::MAX_SLOPE_POINTS).contains(&sp) {
+            p.push(
+                "filtering.slope_points",
+                format!("must be in 1..={}, got {sp}", Filtering::MAX_SLOPE_POINTS),
+            );
+        }
+        if p.0.is_empty() { Ok(()) } else { Err(p.0) }
+    }
+
+    /// Slope covariance σ_nx², σ_ny² of the (pre-transfer) surface.
+    pub fn slope_cov(&self) -> SlopeCov {
+        SlopeCov::from_std(self.slopes.sigma_nx, self.slopes.sigma_ny)
+    }
+
+    /// The noise realisation whose `h = σ_h·f` has this material's σ_h and σ_n; `None` for an image driver.
+    pub fn noise(&self) -> Option<SumOfSines> {
+        let Driver::Noise(params) = &self.driver else {
+            return None;
+        };
+        let sh = self.heights.sigma_h;
+        let target = if sh > 0.0 {
+            self.slope_cov().scaled(1.0 / sh.max(1e-12))
+        } else {
+            SlopeCov::default()
+        };
+        Some(SumOfSines::new(params, target))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::material::colormap::{ColorStop, Interpolation};
+
+    #[test]
+    fn round_trips_through_ron() {
+        let m = Material::default();
+        let text = m.to_ron();
+        let back = Material::from_ron(&text).expect("default material parses");
+        assert_eq!(m, back);
+    }
+
+    #[test]
+    fn parse_errors_have_line_and_column() {
+        let text = Material::default()
+            .to_ron()
+            .replacen("sigma_h: 0.05", "sigma_h: oops", 1);
+        match Material::from_ron(&text) {
+            Err(MaterialError::Parse { line, column, .. }) => {
+                assert!(line > 1 && column > 1, "{line}:{column}")
+            }
+            other => panic!("expected a parse error, got {other:?}"),
+        }
+        let unknown =
+            Material::default()
+                .to_ron()
+                .replacen("sigma_h:", "sigma_hh: 1.0, sigma_h:", 1);
+        assert!(matches!(
+            Material::from_ron(&unknown),
+            Err(MaterialError::Parse { .. })
+        ));
+    }
+
+    #[test]
+    fn newer_versions_are_refused() {
+        let text = Material::default()
+            .to_ron()
+            .replacen("version: 1", "version: 99", 1);
+        assert!(matches!(
+            Material::from_ron(&text),
+            Err(MaterialError::TooNew { found: 99, .. })
+        ));
+    }
+
+    #[test]
+    fn validation_reports_every_invalid_field() {
+        let mut m = Material::default();
+        m.heights.sigma_h = -1.0;
+        m.slopes.sigma_nx = f64::NAN;
+        m.brdf.albedo = 2.0;
+        m.filtering.table.size_m = 1;
+        m.color = ColorModel::Gradient {
+            map: Gradient {
+                stops: vec![
+                    ColorStop {
+                        position: 1.0,
+                        color: [0.1; 3],
+                    },
+                    ColorStop {
+                        position: 0.0,
+                        color: [0.2; 3],
+                    },
+                ],
+                interpolation: Interpolation::Linear,
+            },
+            source: ColorSource::Driver,
+        };
+        let problems = m.validate().unwrap_err();
+        let fields: Vec<_> = problems.iter().map(|p| p.field.as_str()).collect();
+        for f in [
+            "heights.sigma_h",
+            "slopes.sigma_nx",
+            "brdf.albedo",
+            "filtering.table.size_m",
+            "color.map.stops[1].position",
+        ] {
+            assert!(fields.contains(&f), "{f} missing from {fields:?}");
+        }
+        assert_eq!(problems.len(), 5);
+    }
+
+    #[test]
+    fn noise_has_the_materials_statistics() {
+        let m = Material::default();
+        let n = m.noise().unwrap();
+        let g = n.gradient_cov().scaled(m.heights.sigma_h);
+        assert!((g.xx.sqrt() - 0.35).abs() < 1e-9 && (g.yy.sqrt() - 0.35).abs() < 1e-9);
+    }
+}

@@ -1,0 +1,11 @@
+//! Math utilities with no knowledge of materials or rendering: special functions and their f32
+//! mirror, quadrature, piecewise polynomials, spherical harmonics, Gaussian helpers and the
+//! reproducible random numbers of the Monte Carlo paths.
+
+pub mod gaussian;
+pub mod piecewise;
+pub mod quadrature;
+pub mod random;
+pub mod sh;
+pub mod special;
+pub mod special_f32;

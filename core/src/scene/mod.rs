@@ -1,0 +1,9 @@
+//! What the views look at and from where: directions and tangent frames, the orbit camera and its
+//! pixel footprints, the closed set of shapes (plane, cylinder) and the explicit micro-geometry
+//! ([`surface::Surface`]) with its rigorous ray march.
+
+pub mod camera;
+pub mod cylinder;
+pub mod direction;
+pub mod shape;
+pub mod surface;

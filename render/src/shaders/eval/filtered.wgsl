@@ -1,0 +1,50 @@
+// Mirror of `core/src/eval/filtered.rs`, function for function under the same names.
+// `//#if feature` blocks are stripped by render/src/specialize.rs when a scene does not use the feature.
+
+// Evaluator::filtered.
+fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>, sun_visible: f32) -> vec3<f32> {
+    let loc = footprint_stats(x0, fp);
+//#if relief
+    let nbar = normal_of(loc.stats.slope_mean);
+    let t = basis_t(nbar);
+    let b = basis_b(nbar);
+    let wo = vec3<f32>(dot(wo_w, t), dot(wo_w, b), dot(wo_w, nbar));
+    let wi = vec3<f32>(dot(wi_w, t), dot(wi_w, b), dot(wi_w, nbar));
+    if (wo.z <= 0.0 || wo_w.z <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let cov = loc.stats.slope_cov;
+    let ms = masking_shadowing(wo, wi, cov);
+    let d = input_distribution(loc);
+    // The colour model over the visible and lit heights (L = Λo + Λi) for the directional light,
+    // over the visible heights (L = Λo) for the unshadowed environment.
+    let hm = height_moments(ms.total);
+    let sun_color = affine(color_of_distribution(d.x + d.y * hm.mean, d.y * hm.std_dev, ms.total, vec2<f32>(hm.mean, hm.std_dev), d.y * d.y));
+    var env_color = sun_color;
+//#if environment
+    let hmo = height_moments(ms.lambda_o);
+    env_color = affine(color_of_distribution(d.x + d.y * hmo.mean, d.y * hmo.std_dev, ms.lambda_o, vec2<f32>(hmo.mean, hmo.std_dev), d.y * d.y));
+//#endif
+    var vbar = 0.0;
+    if (wi.z > 0.0 && wi_w.z > 0.0) {
+        // Kept without the shadows feature: a light at the world normal is oblique to a tilted
+        // mean normal, so Λ(ω_i) need not be 0 in the footprint's frame.
+        vbar = mean_shadowing(ms);
+    }
+    // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
+    let s_mean = loc.stats.slope_mean;
+    let shading = visible_shading(s_mean, cov, wo_w, wi_w);
+    let spec = filtered_specular(s_mean, cov, wo_w, wi_w);
+    return radiance(sun_color, env_color, shading, sun_visible * vbar, spec);
+//#else
+    // Flat: every facet faces +z, nothing masks or shadows (Λ = 0, and D_h at L = 0 is the
+    // identity, so the colour is that of the footprint's own distribution).
+    if (wo_w.z <= 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let d = input_distribution(loc);
+    let aff = affine(color_of_distribution(d.x, d.y, 0.0, vec2<f32>(0.0, 1.0), d.y * d.y));
+    let spec = filtered_specular(vec2<f32>(0.0), vec3<f32>(0.0), wo_w, wi_w);
+    return radiance(aff, aff, point_shading(vec3<f32>(0.0, 0.0, 1.0), wi_w), sun_visible * select(0.0, 1.0, wi_w.z > 0.0), spec);
+//#endif
+}

@@ -1,0 +1,112 @@
+// Mirror of `core/src/eval/shading.rs`, function for function under the same names.
+// `//#if feature` blocks are stripped by render/src/specialize.rs when a scene does not use the feature.
+
+// Evaluator::slope_color_at (CompiledSlopeColor::sample) at a world normal.
+fn slope_color_at(nw: vec3<f32>) -> vec3<f32> {
+//#if slope_color
+    let k = params.sp_knots;
+    if (k == 0u) {
+        return vec3<f32>(0.0);
+    }
+    let t = dot(nw, params.sc_dir);
+    return vec3<f32>(poly_eval(params.sp_offset, k, 3u, 0u, t), poly_eval(params.sp_offset, k, 3u, 1u, t), poly_eval(params.sp_offset, k, 3u, 2u, t));
+//#else
+    return vec3<f32>(0.0);
+//#endif
+}
+
+// Sh9::irradiance (coefficients pre-multiplied by Â_l, coefficient-major RGB) at a world normal.
+fn environment_at(nw: vec3<f32>) -> vec3<f32> {
+//#if environment
+    if (params.has_env == 0u) {
+        return vec3<f32>(0.0);
+    }
+    let o = params.env_offset;
+    let x = nw.x;
+    let y = nw.y;
+    let z = nw.z;
+    let b = array<f32, 9>(0.282095, 0.488603 * y, 0.488603 * z, 0.488603 * x, 1.092548 * x * y, 1.092548 * y * z, 0.315392 * (3.0 * z * z - 1.0), 1.092548 * x * z, 0.546274 * (x * x - y * y));
+    var e = vec3<f32>(0.0);
+    for (var i = 0u; i < 9u; i = i + 1u) {
+        e = e + b[i] * vec3<f32>(data[o + 3u * i], data[o + 3u * i + 1u], data[o + 3u * i + 2u]);
+    }
+    return max(e, vec3<f32>(0.0));
+//#else
+    return vec3<f32>(0.0);
+//#endif
+}
+
+// The tangent frame's axes in the world (identity on the plane; the cylinder sets its own before
+// shading): slope colour and environment are looked up at world normals.
+var<private> shading_frame: mat3x3<f32> = mat3x3<f32>(1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+
+struct SlopeShading {
+    cos: f32,
+    cs_cos: vec3<f32>,
+    env: vec3<f32>,
+    cs_env: vec3<f32>,
+}
+
+// Evaluator::point_shading.
+fn point_shading(n: vec3<f32>, wi: vec3<f32>) -> SlopeShading {
+    var r: SlopeShading;
+    r.cos = max(dot(n, wi), 0.0);
+    let nw = shading_frame * n;
+    let cs = slope_color_at(nw);
+    r.env = environment_at(nw);
+    r.cs_cos = cs * r.cos;
+    r.cs_env = cs * r.env;
+    return r;
+}
+
+// Evaluator::radiance.
+fn radiance(sun_color: Affine, env_color: Affine, s: SlopeShading, v: f32, spec: f32) -> vec3<f32> {
+    let sun = params.sun * v;
+    let kd = params.albedo * FRAC_1_PI;
+    return kd * (sun * (sun_color.a * s.cos + sun_color.k * s.cs_cos) + env_color.a * s.env + env_color.k * s.cs_env) + vec3<f32>(sun * spec);
+}
+
+fn has_environment() -> bool {
+//#if environment
+    return params.has_env != 0u;
+//#else
+    return false;
+//#endif
+}
+
+//#if relief
+// Evaluator::visible_shading: point_shading averaged on the nodes of D_s (visible_slope_nodes),
+// world slope space, slopes N(mean, cov).
+fn visible_shading(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> SlopeShading {
+    let l = cholesky(cov);
+    let nodes = params.slope_points * params.slope_points;
+    var acc: SlopeShading;
+    acc.cos = 0.0;
+    acc.cs_cos = vec3<f32>(0.0);
+    acc.env = vec3<f32>(0.0);
+    acc.cs_env = vec3<f32>(0.0);
+    var den = 0.0;
+    for (var i = 0u; i < nodes; i = i + 1u) {
+        let z = slope_node(i);
+        let s = mean + vec2<f32>(l.x * z.x, l.y * z.x + l.z * z.y);
+        let u = max(wo.z - s.x * wo.x - s.y * wo.y, 0.0);
+        let wt = z.z * u;
+        if (wt > 0.0) {
+            let p = point_shading(normal_of(s), wi);
+            acc.cos = acc.cos + wt * p.cos;
+            acc.cs_cos = acc.cs_cos + wt * p.cs_cos;
+            acc.env = acc.env + wt * p.env;
+            acc.cs_env = acc.cs_env + wt * p.cs_env;
+            den = den + wt;
+        }
+    }
+    if (den > 0.0) {
+        let inv = 1.0 / den;
+        acc.cos = acc.cos * inv;
+        acc.cs_cos = acc.cs_cos * inv;
+        acc.env = acc.env * inv;
+        acc.cs_env = acc.cs_env * inv;
+    }
+    return acc;
+}
+//#endif

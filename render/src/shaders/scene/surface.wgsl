@@ -1,0 +1,109 @@
+// Mirror of `core/src/scene/surface.rs`, function for function under the same names.
+// `//#if feature` blocks are stripped by render/src/specialize.rs when a scene does not use the feature.
+
+//#if relief|curved
+fn surface_height(x: vec2<f32>) -> f32 {
+    return params.sigma_h * transfer_eval(value_and_gradient(x).x).x;
+}
+
+//#endif
+//#if relief
+fn lipschitz_along(dir: vec2<f32>) -> f32 {
+//#if image
+    if (params.driver_kind == DRIVER_IMAGE) {
+        return params.sigma_h * params.g_lip * image_lipschitz_along(dir);
+    }
+//#endif
+    var s = 0.0;
+//#if noise
+    for (var i = 0u; i < params.wave_count; i = i + 1u) {
+        let w = wave(i);
+        s = s + abs(w.z) * TAU * abs(dot(w.xy, dir));
+    }
+//#endif
+    return params.sigma_h * params.g_lip * s;
+}
+
+// Height of the explicit surface (lod = false) or of the level-of-detail surface (lod = true, needs
+// lod_prepare first).
+fn field_height(x: vec2<f32>, lod: bool, sf: f32) -> f32 {
+    if (lod) {
+        return lod_height(x, sf);
+    }
+    return surface_height(x);
+}
+
+// surface::march_heightfield (over-relaxed; backs off when the safe intervals of two points do not
+// cover the step, before concluding anything at the new point): t of the first crossing, or -1 when
+// the ray leaves the slab.
+fn march_heightfield(o: vec3<f32>, d: vec3<f32>, rate: f32, lod: bool, sf: f32) -> f32 {
+    if (!(rate > 0.0)) {
+        return -1.0;
+    }
+    let top = params.h_max * (1.0 + 1e-6) + 1e-30;
+    // f32 guard (core marches in f64 and needs none): a step must move the point by more than the
+    // rounding of its coordinates, or a march leaving the surface never leaves it (its rounding-level
+    // negative gap then reads as a crossing: false shadows at extreme frequencies, σ_n ≫ σ_h).
+    let min_step = max(params.min_step, 4.8e-7 * (max(max(abs(o.x), abs(o.y)), abs(o.z)) + top));
+    var t = 0.0;
+    var prev_t = 0.0;
+    var prev_r = 0.0;
+    var relaxed = false;
+    for (var it = 0u; it < 20000u; it = it + 1u) {
+        let p = o + d * t;
+        var gap = p.z - field_height(p.xy, lod, sf);
+        if (gap < 0.0 && t == 0.0) {
+            // The origin is on the surface by contract: a negative gap here is rounding.
+            gap = 0.0;
+        }
+        let r = max(gap, 0.0) / rate;
+        if (relaxed && t - prev_t > prev_r + r) {
+            // The relaxed step left a stretch no safe interval covers: back off and step safely.
+            t = prev_t + max(prev_r, min_step);
+            relaxed = false;
+            continue;
+        }
+        if ((d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0)) {
+            return -1.0;
+        }
+        if (gap < 0.0) {
+            var a = prev_t;
+            var b = t;
+            for (var j = 0u; j < 24u; j = j + 1u) {
+                let m = 0.5 * (a + b);
+                let q = o + d * m;
+                if (q.z - field_height(q.xy, lod, sf) >= 0.0) {
+                    a = m;
+                } else {
+                    b = m;
+                }
+            }
+            return a;
+        }
+        prev_t = t;
+        prev_r = r;
+        let safe = max(r, min_step);
+        let step = max(RELAXATION * r, min_step);
+        relaxed = step > safe;
+        t = t + step;
+    }
+    return -1.0;
+}
+
+// Surface::march.
+fn march(o: vec3<f32>, d: vec3<f32>) -> f32 {
+    let r = length(d.xy);
+    var k = 0.0;
+    if (r > 0.0) {
+        k = lipschitz_along(d.xy / r);
+    }
+    return march_heightfield(o, d, abs(d.z) + k * r, false, 0.0);
+}
+
+fn sees(p: vec3<f32>, d: vec3<f32>) -> bool {
+    if (d.z <= 0.0) {
+        return false;
+    }
+    return march(p, d) < 0.0;
+}
+//#endif
