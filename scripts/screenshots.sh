@@ -13,3 +13,7 @@ done
 ./target/release/lodestone render --mode all --formats png --shape cylinder --radius 1.5 \
     --view-deg 75 --view-azimuth-deg 90 --light-deg 40 --light-azimuth-deg 150 --distance 7 \
     --size 320x180 --spp 128 --out screenshots/views/cylinder | tee screenshots/views/cylinder.txt
+# Lossless recompression keeps the repository small (pixels and colour chunks unchanged).
+if command -v optipng >/dev/null; then
+    find screenshots -name '*.png' -newer scripts/screenshots.sh -print0 | xargs -0 -r optipng -quiet -o2
+fi
