@@ -57,8 +57,13 @@ pub const MATERIAL_FILES: &[(&str, &str)] = wgsl_files![
 /// The image driver (mirrors `lodestone_core::driver::image` and the image half of `driver::field`).
 pub const IMAGE_DRIVER: &str = include_str!("shaders/driver/image.wgsl");
 
-/// The curved object (mirrors `lodestone_core::scene::cylinder` and `lodestone_core::eval::cylinder`).
-pub const CYLINDER: &str = include_str!("shaders/scene/cylinder.wgsl");
+/// The curved object: its geometry (mirrors `lodestone_core::scene::cylinder`) and its pixels
+/// (mirrors `lodestone_core::eval::cylinder`).
+pub const CYLINDER: &str = concat!(
+    include_str!("shaders/scene/cylinder.wgsl"),
+    "\n",
+    include_str!("shaders/eval/cylinder.wgsl")
+);
 
 /// The view pass (camera rays, footprints, modes, progressive ground truth).
 pub const VIEW: &str = include_str!("shaders/view.wgsl");
@@ -106,7 +111,14 @@ pub fn files() -> Vec<(&'static str, &'static str)> {
     v.extend_from_slice(MATERIAL_FILES);
     v.extend([
         ("driver/image.wgsl", IMAGE_DRIVER),
-        ("scene/cylinder.wgsl", CYLINDER),
+        (
+            "scene/cylinder.wgsl",
+            include_str!("shaders/scene/cylinder.wgsl"),
+        ),
+        (
+            "eval/cylinder.wgsl",
+            include_str!("shaders/eval/cylinder.wgsl"),
+        ),
         ("view.wgsl", VIEW),
     ]);
     v

@@ -30,13 +30,7 @@ mod tests {
     /// Unit length, the angles it was built from, and an orthonormal right-handed basis.
     #[test]
     fn directions_and_bases() {
-        for (t, p) in [
-            (0.0, 0.0),
-            (0.3, 1.0),
-            (1.2, -2.0),
-            (1.4, 3.0),
-            (2.5, 0.4),
-        ] {
+        for (t, p) in [(0.0, 0.0), (0.3, 1.0), (1.2, -2.0), (1.4, 3.0), (2.5, 0.4)] {
             let d = direction(t, p);
             assert!((d.length() - 1.0).abs() < 1e-12);
             assert!((d.z.acos() - t).abs() < 1e-9);

@@ -1,0 +1,111 @@
+// Mirror of `core/src/eval/cylinder.rs`: ground truth on the explicit displaced cylinder and the
+// analytic views in the tangent plane where the ray meets the mean cylinder. Needs the special,
+// material and view-parameter units and scene/cylinder.wgsl.
+
+fn cylinder_gap(p: vec3<f32>) -> f32 {
+    let s = cylinder_to_surface(p);
+    return s.z - view_params.radius - surface_height(s.xy);
+}
+
+// Evaluator::cylinder_march: t of the crossing, or -1.
+fn cylinder_march(o: vec3<f32>, d: vec3<f32>, t_max: f32) -> f32 {
+    let r = view_params.radius;
+    let rho_min = max(r - params.h_max, 1e-6 * r);
+    let k = params.slope_bound * r / rho_min;
+    let rate = sqrt(1.0 + k * k);
+    var t = 0.0;
+    var prev_t = 0.0;
+    var prev_r = 0.0;
+    var relaxed = false;
+    for (var it = 0u; it < 20000u; it = it + 1u) {
+        var gap = cylinder_gap(o + d * t);
+        if (gap < 0.0 && t == 0.0) {
+            gap = 0.0;
+        }
+        let rr = max(gap, 0.0) / rate;
+        if (relaxed && t - prev_t > prev_r + rr) {
+            t = prev_t + max(prev_r, params.min_step);
+            relaxed = false;
+            continue;
+        }
+        if (t > t_max) {
+            return -1.0;
+        }
+        if (gap < 0.0) {
+            var a = prev_t;
+            var b = t;
+            for (var j = 0u; j < 24u; j = j + 1u) {
+                let m = 0.5 * (a + b);
+                if (cylinder_gap(o + d * m) >= 0.0) {
+                    a = m;
+                } else {
+                    b = m;
+                }
+            }
+            return a;
+        }
+        prev_t = t;
+        prev_r = rr;
+        let safe = max(rr, params.min_step);
+        let step = max(RELAXATION * rr, params.min_step);
+        relaxed = step > safe;
+        t = t + step;
+    }
+    return -1.0;
+}
+
+// Evaluator::cylinder_trace_ray.
+fn cylinder_trace_ray(origin: vec3<f32>, dir: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    let r = view_params.radius;
+    let outer = r + params.h_max * 1.001 + 1e-6;
+    let span = cylinder_intersect(outer, origin, dir);
+    if (span.y < 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let o = origin + dir * span.x;
+    let t = cylinder_march(o, dir, span.y - span.x);
+    if (t < 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let p = o + dir * t;
+    let s = cylinder_to_surface(p);
+    let fg = value_and_gradient(s.xy);
+    let gd = transfer_eval(fg.x);
+    let grad = fg.yz * (params.sigma_h * gd.y);
+    let n = normal_of(vec2<f32>(grad.x, grad.y * r / max(s.z, 1e-30)));
+    shading_frame = cylinder_frame(s.w);
+    let fr = transpose(shading_frame);
+    let wo_l = fr * -dir;
+    let wi_l = fr * wi;
+    // Evaluator::shade_hit with the cylinder's shadow ray.
+    let lit = dot(n, wi_l) > 0.0 && params.sun > 0.0;
+    if (!lit && !has_environment()) {
+        return vec3<f32>(0.0);
+    }
+    var v = select(0.0, 1.0, lit);
+    if (lit) {
+        let shadow = cylinder_intersect(outer, p, wi);
+        if (shadow.y >= 0.0 && cylinder_march(p, wi, shadow.y) >= 0.0) {
+            v = 0.0;
+        }
+    }
+    return shade_point(fg.x, n, wo_l, wi_l, v);
+}
+
+// Evaluator::cylinder_pixel, for the unnormalised camera direction d of a pixel.
+fn cylinder_pixel(method: u32, d: vec3<f32>, dx: vec3<f32>, dy: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+    let dir = normalize(d);
+    let span = cylinder_intersect(view_params.radius, view_params.eye, dir);
+    if (span.y < 0.0) {
+        return vec3<f32>(0.0);
+    }
+    let hit = view_params.eye + dir * span.x;
+    let s = cylinder_to_surface(hit);
+    let fr = cylinder_frame(s.w);
+    shading_frame = fr;
+    let fp = tangent_footprint(d, dx, dy, hit, fr);
+    let frt = transpose(fr);
+    let q = frt * (view_params.eye - hit);
+    let o = vec3<f32>(s.x + q.x, s.y + q.y, q.z);
+    return analytic_pixel(method, o, frt * dir, frt * wi, fp);
+}
