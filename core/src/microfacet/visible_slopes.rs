@@ -254,8 +254,11 @@ pub fn slope_mean(
 }
 
 /// `E[u⁺]` for `u = a − s·b` with `s ~ N(mean, Σ)`: `mΦ(m/√v) + √v φ(m/√v)`, `m = a − mean·b`,
-/// `v = bᵀΣb` (`m⁺` when v = 0).
-pub(crate) fn expected_positive_part(a: f64, b: DVec2, mean: DVec2, sigma: &SlopeCov) -> f64 {
+/// `v = bᵀΣb` — the normaliser Z of the visible slope distribution (its projected area).
+///
+/// Edge cases: `m⁺` when v ≤ 1e-300 (no spread along b); `m/√v` is clamped to ±40, where the
+/// result is `m` or 0 to f64 precision, so it is finite and ≥ 0 for finite inputs.
+pub fn expected_positive_part(a: f64, b: DVec2, mean: DVec2, sigma: &SlopeCov) -> f64 {
     let m = a - mean.dot(b);
     let v = b.x * b.x * sigma.xx + 2.0 * b.x * b.y * sigma.xy + b.y * b.y * sigma.yy;
     if v > 1e-300 {
