@@ -80,12 +80,23 @@ pub enum Command {
         #[arg(long, value_enum, default_value_t = Formats::Both)]
         formats: Formats,
     },
-    /// Time each mode's frame on the GPU adapter (medians of repeated frames) and the
-    /// filtered/naive cost ratio.
+    /// Time each mode's frame on the GPU adapter (medians of repeated frames) over presets × view
+    /// angles × distances, against a "flat" reference (the same camera and colour with σ_h = 0: the
+    /// cost of a textured plane), with the filtered/naive cost ratio.
     Bench {
         /// Image size, WxH.
         #[arg(long, default_value = "512x512", value_parser = parse_size)]
         size: (u32, u32),
+        /// Camera angles from the normal to sweep, degrees (comma-separated).
+        #[arg(long, default_value = "60", value_delimiter = ',')]
+        view_deg: Vec<f64>,
+        /// Camera distances to sweep, world units (comma-separated).
+        #[arg(long, default_value = "6", value_delimiter = ',')]
+        distance: Vec<f64>,
+        /// Presets to sweep (comma-separated RON files); the global --preset (or the built-in
+        /// default) when omitted.
+        #[arg(long, value_delimiter = ',')]
+        presets: Vec<PathBuf>,
         /// Timed frames per mode (after one warm-up frame).
         #[arg(long, default_value_t = 5)]
         frames: u32,

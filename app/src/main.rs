@@ -157,8 +157,33 @@ fn run(cli: Cli) -> Result<()> {
             };
             render_cmd::render(&preset, view, mode, size, spp, &out, formats)?;
         }
-        Some(Command::Bench { size, frames, json }) => {
-            render_cmd::bench(&preset, size, frames, json)?
+        Some(Command::Bench {
+            size,
+            frames,
+            json,
+            view_deg,
+            distance,
+            presets,
+        }) => {
+            let mut sweep = vec![];
+            if presets.is_empty() {
+                let name = cli
+                    .preset
+                    .as_ref()
+                    .map_or("default".to_owned(), |p| p.display().to_string());
+                sweep.push((name, preset));
+            } else {
+                for p in &presets {
+                    sweep.push((p.display().to_string(), load(Some(p))?));
+                }
+            }
+            let cfg = render_cmd::BenchSweep {
+                view_deg,
+                distance,
+                size,
+                frames,
+            };
+            render_cmd::bench(&sweep, &cfg, json)?
         }
         Some(Command::Export { out }) => {
             let written = preset_io::export_bundle(&preset, &out)?;

@@ -191,56 +191,164 @@ pub fn frame_ms(
     median(times)
 }
 
-/// `lodestone bench`.
-pub fn bench(preset: &Resolved, size: (u32, u32), frames: u32, json: bool) -> Result<()> {
-    let prepared = preset.prepare()?;
+/// What `lodestone bench` sweeps.
+#[derive(Clone, Debug)]
+pub struct BenchSweep {
+    /// Camera angles from the normal (degrees).
+    pub view_deg: Vec<f64>,
+    /// Camera distances (world units).
+    pub distance: Vec<f64>,
+    /// Image size.
+    pub size: (u32, u32),
+    /// Timed batches per mode.
+    pub frames: u32,
+}
+
+/// The modes a bench row times, with their JSON names.
+const BENCH_MODES: [(&str, ViewMode); 4] = [
+    ("naive", ViewMode::Naive),
+    ("view_independent", ViewMode::ViewIndependent),
+    ("filtered", ViewMode::Filtered),
+    ("truth", ViewMode::Truth),
+];
+
+/// One configuration's timings (ms per frame).
+#[derive(Clone, Debug)]
+pub struct BenchRow {
+    /// The preset.
+    pub preset: String,
+    /// Camera angle from the normal (degrees).
+    pub view_deg: f64,
+    /// Camera distance.
+    pub distance: f64,
+    /// The same camera and colour with σ_h = 0 (no relief: a textured plane), naive mode.
+    pub flat_ms: f64,
+    /// Each mode's frame (truth: one ray per pixel).
+    pub frame_ms: std::collections::BTreeMap<String, f64>,
+}
+
+impl BenchRow {
+    fn ms(&self, mode: &str) -> f64 {
+        self.frame_ms.get(mode).copied().unwrap_or(f64::NAN)
+    }
+}
+
+/// `lodestone bench`: every preset × view angle × distance, each mode's frame time and the flat
+/// reference's, light 30° at azimuth 90°.
+pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Result<()> {
     let r = renderer()?;
-    let scene = View {
-        view_deg: 60.0,
-        view_azimuth_deg: 0.0,
-        light_deg: 30.0,
-        light_azimuth_deg: 90.0,
-        distance: 6.0,
-        shape: Shape::Plane,
-    }
-    .scene();
-    let gm = GpuMaterial::new(r.context(), &prepared, scene.camera.target);
-    let mut target = ViewTarget::new(&r, size.0, size.1);
+    let (w, h) = cfg.size;
+    let mut target = ViewTarget::new(&r, w, h);
     let mut rows = vec![];
-    for (name, mode) in [
-        ("naive", ViewMode::Naive),
-        ("view_independent", ViewMode::ViewIndependent),
-        ("filtered", ViewMode::Filtered),
-        ("truth (1 ray/pixel)", ViewMode::Truth),
-    ] {
-        rows.push((name, frame_ms(&r, &mut target, &gm, &scene, mode, frames)));
+    for (name, preset) in presets {
+        let prepared = preset.prepare()?;
+        let mut flat_material = preset.clone();
+        flat_material.material.heights.sigma_h = 0.0;
+        let flat = flat_material.prepare()?;
+        for &distance in &cfg.distance {
+            for &view_deg in &cfg.view_deg {
+                let scene = View {
+                    view_deg,
+                    view_azimuth_deg: 0.0,
+                    light_deg: 30.0,
+                    light_azimuth_deg: 90.0,
+                    distance,
+                    shape: Shape::Plane,
+                }
+                .scene();
+                let gm = GpuMaterial::new(r.context(), &prepared, scene.camera.target);
+                let gflat = GpuMaterial::new(r.context(), &flat, scene.camera.target);
+                let flat_ms =
+                    frame_ms(&r, &mut target, &gflat, &scene, ViewMode::Naive, cfg.frames);
+                let frame_ms = BENCH_MODES
+                    .iter()
+                    .map(|(n, mode)| {
+                        target.reset();
+                        let ms = frame_ms(&r, &mut target, &gm, &scene, *mode, cfg.frames);
+                        ((*n).to_owned(), ms)
+                    })
+                    .collect();
+                rows.push(BenchRow {
+                    preset: name.clone(),
+                    view_deg,
+                    distance,
+                    flat_ms,
+                    frame_ms,
+                });
+            }
+        }
     }
-    let ratio = rows[2].1 / rows[0].1;
     let adapter = r.context().describe();
+    let pixels = f64::from(w) * f64::from(h);
     if json {
-        let modes: serde_json::Map<String, serde_json::Value> = rows
-            .iter()
-            .map(|(n, ms)| ((*n).to_string(), serde_json::json!(ms)))
-            .collect();
         let v = serde_json::json!({
             "adapter": adapter,
-            "size": [size.0, size.1],
-            "frames": frames,
+            "size": [w, h],
+            "frames": cfg.frames,
             "timing": "synchronised wall time per frame: median over batches of 8 back-to-back frames",
-            "frame_ms": modes,
-            "filtered_over_naive": ratio,
+            "flat": "the same camera and colour table with sigma_h = 0 (a textured plane), naive mode",
+            "rows": rows.iter().map(|row| serde_json::json!({
+                "preset": row.preset,
+                "view_deg": row.view_deg,
+                "distance": row.distance,
+                "flat_ms": row.flat_ms,
+                "frame_ms": row.frame_ms,
+                "over_flat": BENCH_MODES.iter().map(|(n, _)| ((*n).to_owned(), serde_json::json!(row.ms(n) / row.flat_ms))).collect::<serde_json::Map<_, _>>(),
+                "filtered_over_naive": row.ms("filtered") / row.ms("naive"),
+                "truth_ns_per_ray": row.ms("truth") * 1e6 / pixels,
+            })).collect::<Vec<_>>(),
         });
         outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         outln!(
-            "{adapter}, {}×{}, median over {frames} batches of 8 frames (synchronised wall time)",
-            size.0,
-            size.1
+            "{adapter}, {w}×{h}, median over {} batches of 8 frames (synchronised wall time); \
+             ×flat = frame time over the same view with σ_h = 0",
+            cfg.frames
         );
-        for (n, ms) in &rows {
-            outln!("{n:>22}: {ms:9.2} ms");
+        outln!(
+            "{:<28} {:>5} {:>6} {:>9} {:>9} {:>6} {:>9} {:>9} {:>6} {:>9} {:>6} {:>9} {:>6}",
+            "preset",
+            "view",
+            "dist",
+            "flat ms",
+            "naive ms",
+            "×flat",
+            "v-ind ms",
+            "filt ms",
+            "×flat",
+            "truth ms",
+            "×flat",
+            "ns/ray",
+            "f/n"
+        );
+        for row in &rows {
+            let (f, n, v, fi, t) = (
+                row.flat_ms,
+                row.ms("naive"),
+                row.ms("view_independent"),
+                row.ms("filtered"),
+                row.ms("truth"),
+            );
+            outln!(
+                "{:<28} {:>5.1} {:>6.2} {f:>9.2} {n:>9.2} {:>6.2} {v:>9.2} {fi:>9.2} {:>6.2} {t:>9.2} {:>6.2} {:>9.1} {:>6.2}",
+                short_name(&row.preset),
+                row.view_deg,
+                row.distance,
+                n / f,
+                fi / f,
+                t / f,
+                t * 1e6 / pixels,
+                fi / n
+            );
         }
-        outln!("{:>22}: {ratio:9.2}×", "filtered / naive");
     }
     Ok(())
+}
+
+/// The file name of a preset path (the whole string when it has none), at most 28 characters.
+fn short_name(p: &str) -> String {
+    let name = Path::new(p)
+        .file_name()
+        .map_or_else(|| p.to_owned(), |n| n.to_string_lossy().into_owned());
+    name.chars().take(28).collect()
 }

@@ -348,3 +348,66 @@ fn environment_file_matches_the_procedural_sky_and_a_missing_one_exits_2() {
         "{err}"
     );
 }
+
+/// `lodestone bench` sweeps presets × distances × view angles: one row each, every mode and the
+/// flat reference timed (finite, positive), the ratios consistent with the times; a missing preset
+/// in the sweep exits 2 naming it.
+#[test]
+fn bench_sweeps_presets_distances_and_views_against_the_flat_reference() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../presets/");
+    let presets = format!("{dir}default.ron,{dir}moss.ron");
+    let out = lodestone(&[
+        "bench",
+        "--json",
+        "--size",
+        "16x12",
+        "--frames",
+        "1",
+        "--distance",
+        "1.5,40",
+        "--view-deg",
+        "60",
+        "--presets",
+        &presets,
+    ]);
+    if out.status.code() == Some(3) {
+        eprintln!("skipping the bench: no adapter");
+        return;
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}\n{text}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+    let rows = v["rows"].as_array().expect("rows");
+    assert_eq!(rows.len(), 4, "2 presets × 2 distances × 1 view");
+    let positive = |x: &serde_json::Value| x.as_f64().is_some_and(|x| x.is_finite() && x > 0.0);
+    for row in rows {
+        assert!(positive(&row["flat_ms"]), "{row}");
+        for mode in ["naive", "view_independent", "filtered", "truth"] {
+            let ms = &row["frame_ms"][mode];
+            assert!(positive(ms), "{mode}: {row}");
+            let ratio = row["over_flat"][mode].as_f64().unwrap();
+            let want = ms.as_f64().unwrap() / row["flat_ms"].as_f64().unwrap();
+            assert!((ratio - want).abs() <= 1e-12 * want, "{mode}: {row}");
+        }
+    }
+    assert!(rows[0]["preset"].as_str().unwrap().ends_with("default.ron"));
+    assert_eq!(rows[1]["distance"], 40.0);
+    assert!(rows[3]["preset"].as_str().unwrap().ends_with("moss.ron"));
+
+    let missing = format!("{dir}does-not-exist.ron");
+    let out = lodestone(&[
+        "bench",
+        "--size",
+        "8x8",
+        "--frames",
+        "1",
+        "--presets",
+        &missing,
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("does-not-exist.ron"));
+}
