@@ -4,7 +4,7 @@
 
 fn cylinder_gap(p: vec3<f32>) -> f32 {
     let s = cylinder_to_surface(p);
-    return s.z - view_params.radius - surface_height(s.xy);
+    return s.rho - view_params.radius - surface_height(s.uv);
 }
 
 // Evaluator::cylinder_march: t of the crossing, or -1.
@@ -69,11 +69,11 @@ fn cylinder_trace_ray(origin: vec3<f32>, dir: vec3<f32>, wi: vec3<f32>) -> vec3<
     }
     let p = o + dir * t;
     let s = cylinder_to_surface(p);
-    let fg = value_and_gradient(s.xy);
+    let fg = value_and_gradient(s.uv);
     let gd = transfer_eval(fg.x);
     let grad = fg.yz * (params.sigma_h * gd.y);
-    let n = normal_of(vec2<f32>(grad.x, grad.y * r / max(s.z, 1e-30)));
-    shading_frame = cylinder_frame(s.w);
+    let n = normal_of(vec2<f32>(grad.x, grad.y * r / max(s.rho, 1e-30)));
+    shading_frame = cylinder_frame(s.phi);
     let fr = transpose(shading_frame);
     let wo_l = fr * -dir;
     let wi_l = fr * wi;
@@ -101,11 +101,11 @@ fn cylinder_pixel(method: u32, d: vec3<f32>, dx: vec3<f32>, dy: vec3<f32>, wi: v
     }
     let hit = view_params.eye + dir * span.x;
     let s = cylinder_to_surface(hit);
-    let fr = cylinder_frame(s.w);
+    let fr = cylinder_frame(s.phi);
     shading_frame = fr;
     let fp = tangent_footprint(d, dx, dy, hit, fr);
     let frt = transpose(fr);
     let q = frt * (view_params.eye - hit);
-    let o = vec3<f32>(s.x + q.x, s.y + q.y, q.z);
+    let o = vec3<f32>(s.uv.x + q.x, s.uv.y + q.y, q.z);
     return analytic_pixel(method, o, frt * dir, frt * wi, fp);
 }

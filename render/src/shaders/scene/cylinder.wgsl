@@ -2,13 +2,21 @@
 // R = view_params.radius around an axis parallel to x through (·, 0, −R); surface coordinates
 // (u, v) = (x, R·φ); micro-geometry displaced along the outward normal.
 
-// cylinder::to_surface: (u, v, ρ, φ).
-fn cylinder_to_surface(p: vec3<f32>) -> vec4<f32> {
+// A world point in the cylinder's coordinates: surface position (u, v), distance ρ from the axis
+// and angle φ from +z toward +y.
+struct CylinderPoint {
+    uv: vec2<f32>,
+    rho: f32,
+    phi: f32,
+}
+
+// cylinder::to_surface.
+fn cylinder_to_surface(p: vec3<f32>) -> CylinderPoint {
     let r = view_params.radius;
     let y = p.y;
     let z = p.z + r;
     let phi = atan2(y, z);
-    return vec4<f32>(p.x, r * phi, sqrt(y * y + z * z), phi);
+    return CylinderPoint(vec2<f32>(p.x, r * phi), sqrt(y * y + z * z), phi);
 }
 
 // cylinder::frame: columns t_u, t_v, n.
