@@ -58,7 +58,8 @@ fn main() {
     );
     let mut rng = 11u64;
     for view_deg in [30.0f64, 60.0, 80.0, 85.0] {
-        let (mut n_ref, mut n_new, mut n_tight, mut same, rays) = (0usize, 0usize, 0usize, 0usize, 400);
+        let (mut n_ref, mut n_new, mut n_tight, mut same, rays) =
+            (0usize, 0usize, 0usize, 0usize, 400);
         for _ in 0..rays {
             let phi = TAU * splitmix(&mut rng);
             let d = -direction(view_deg.to_radians(), phi);
@@ -67,7 +68,8 @@ fn main() {
             let o = DVec3::new(start.x, start.y, top);
             let dxy = DVec2::new(d.x, d.y);
             let r = dxy.length();
-            let rate = d.z.abs() + s.sigma_h * s.g_lip * s.driver.lipschitz_along(dxy / r.max(1e-300)) * r;
+            let rate =
+                d.z.abs() + s.sigma_h * s.g_lip * s.driver.lipschitz_along(dxy / r.max(1e-300)) * r;
             let count = Cell::new(0usize);
             let height = |x: DVec2| {
                 count.set(count.get() + 1);

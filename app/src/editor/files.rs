@@ -32,6 +32,7 @@ impl EditorApp {
         }
     }
 
+    /// Pick a preset by file dialog and open it (asking first about unsaved changes).
     pub(super) fn open_dialog(&mut self, ctx: &egui::Context) {
         let mut dlg = rfd::FileDialog::new().add_filter("Lodestone preset", &["ron"]);
         if let Some(dir) = self.doc.path.as_ref().and_then(|p| p.parent()) {
@@ -58,6 +59,7 @@ impl EditorApp {
         }
     }
 
+    /// Save to the current file, or ask where when there is none. Whether it saved.
     pub(super) fn save(&mut self, ctx: &egui::Context) -> bool {
         match self.doc.path.clone() {
             Some(p) => self.save_to(ctx, &p),
@@ -65,6 +67,7 @@ impl EditorApp {
         }
     }
 
+    /// Ask where, then save there. Whether it saved.
     pub(super) fn save_as(&mut self, ctx: &egui::Context) -> bool {
         let name = format!("{}.ron", slug(&self.doc.material.name));
         let mut dlg = rfd::FileDialog::new()
@@ -79,6 +82,7 @@ impl EditorApp {
         }
     }
 
+    /// Replace the material with the built-in default (no file, nothing unsaved).
     pub(super) fn new_material(&mut self) {
         let m = preset_io::default_material();
         self.inspector = Inspector::new(&m);
@@ -137,6 +141,7 @@ impl EditorApp {
         Ok(written)
     }
 
+    /// The "unsaved changes" dialog of a pending open or new: save, discard or cancel.
     pub(super) fn confirm_dialog(&mut self, ctx: &egui::Context) {
         let Some(pending) = self.pending.clone() else {
             return;
@@ -178,6 +183,8 @@ impl EditorApp {
         }
     }
 
+    /// Files dropped on the window: a `.ron` opens (asking first), an `.hdr`/`.exr` becomes the
+    /// environment (an undoable edit).
     pub(super) fn handle_drops(&mut self, ctx: &egui::Context) {
         let dropped: Vec<PathBuf> = ctx.input(|i| {
             i.raw

@@ -21,6 +21,8 @@ impl Evaluator {
         self.filtered_lit(cfg, 1.0, &DMat3::IDENTITY)
     }
 
+    /// [`Evaluator::filtered`] with the sun's visibility and the tangent frame, as
+    /// [`Evaluator::naive`]'s.
     pub(super) fn filtered_lit(
         &self,
         cfg: &FootprintQuery,

@@ -15,6 +15,8 @@ impl Evaluator {
         self.naive_lit(cfg, 1.0, &DMat3::IDENTITY)
     }
 
+    /// [`Evaluator::naive`] with the directional light's visibility `sun_visible` (the pixel's
+    /// shadow ray) and the tangent frame `frame` (world axes, for slope colour and environment).
     pub(super) fn naive_lit(
         &self,
         cfg: &FootprintQuery,

@@ -47,6 +47,8 @@ pub struct FootprintStats {
 }
 
 impl Evaluator {
+    /// The driver's statistics over the query's footprint, the transfer function's moments over
+    /// them, and the transformed surface's height and slope statistics [HNPN14 Eqs. 19–26].
     pub fn footprint_stats(&self, cfg: &FootprintQuery) -> FootprintStats {
         let driver = self.surface.driver.filtered(cfg.x0, cfg.footprint);
         let transfer = self.transfer.moments(driver.mean, driver.std);

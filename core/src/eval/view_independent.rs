@@ -17,6 +17,8 @@ impl Evaluator {
         self.view_independent_lit(cfg, 1.0, &DMat3::IDENTITY)
     }
 
+    /// [`Evaluator::view_independent`] with the sun's visibility and the tangent frame, as
+    /// [`Evaluator::naive`]'s.
     pub(super) fn view_independent_lit(
         &self,
         cfg: &FootprintQuery,
