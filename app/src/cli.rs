@@ -79,6 +79,9 @@ pub enum Command {
         /// Formats written by `--mode all`.
         #[arg(long, value_enum, default_value_t = Formats::Both)]
         formats: Formats,
+        /// How the ray marches refine a crossing (the reference stays selectable).
+        #[arg(long, value_enum, default_value_t = MarchArg::Fast)]
+        march: MarchArg,
     },
     /// Time each mode's frame on the GPU adapter (medians of repeated frames) over presets × view
     /// angles × distances, against a "flat" reference (the same camera and colour with σ_h = 0: the
@@ -191,6 +194,25 @@ pub enum RenderMode {
     Error,
     /// Every mode and every error map, into a directory.
     All,
+}
+
+/// How marches refine the crossing they find (`lodestone_core::scene::surface::March`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum MarchArg {
+    /// Bisection, 48 halvings on the CPU and 24 on the GPU (the reference).
+    Reference,
+    /// The Illinois method to the same bracket width.
+    Fast,
+}
+
+impl MarchArg {
+    /// The core value.
+    pub fn march(self) -> lodestone_core::scene::surface::March {
+        match self {
+            Self::Reference => lodestone_core::scene::surface::March::Reference,
+            Self::Fast => lodestone_core::scene::surface::March::Fast,
+        }
+    }
 }
 
 /// The object `render` draws.

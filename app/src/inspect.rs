@@ -258,6 +258,7 @@ mod tests {
             light_azimuth_deg: 90.0,
             distance: 6.0,
             shape: Shape::Plane,
+            march: Default::default(),
         }
     }
 

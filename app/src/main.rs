@@ -145,6 +145,7 @@ fn run(cli: Cli) -> Result<()> {
             spp,
             out,
             formats,
+            march,
         }) => {
             let shape = shape.shape(radius).map_err(anyhow::Error::msg)?;
             let view = render_cmd::View {
@@ -154,6 +155,7 @@ fn run(cli: Cli) -> Result<()> {
                 light_azimuth_deg,
                 distance,
                 shape,
+                march: march.march(),
             };
             render_cmd::render(&preset, view, mode, size, spp, &out, formats)?;
         }
@@ -209,6 +211,7 @@ fn run(cli: Cli) -> Result<()> {
                 light_azimuth_deg,
                 distance: 6.0,
                 shape: shape.shape(2.0).map_err(anyhow::Error::msg)?,
+                march: lodestone_core::scene::surface::March::default(),
             };
             let opts = inspect::Options {
                 view,

@@ -6,6 +6,7 @@ use anyhow::{Context, Result, bail};
 use lodestone_core::scene::camera::Camera;
 use lodestone_core::scene::direction::direction;
 use lodestone_core::scene::shape::Shape;
+use lodestone_core::scene::surface::March;
 use lodestone_render::error_map::{abs_difference, error_stats, heat_map};
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
@@ -28,6 +29,8 @@ pub struct View {
     pub distance: f64,
     /// The object.
     pub shape: Shape,
+    /// How the marches refine a crossing.
+    pub march: March,
 }
 
 impl View {
@@ -92,7 +95,8 @@ pub fn render(
     out: &Path,
     formats: Formats,
 ) -> Result<()> {
-    let prepared = preset.prepare()?;
+    let mut prepared = preset.prepare()?;
+    prepared.surface.march = view.march;
     let r = renderer()?;
     let scene = view.scene();
     let gm = GpuMaterial::new(r.context(), &prepared, scene.camera.target);
@@ -223,18 +227,24 @@ pub struct BenchRow {
     pub distance: f64,
     /// The same camera and colour with σ_h = 0 (no relief: a textured plane), naive mode.
     pub flat_ms: f64,
-    /// Each mode's frame (truth: one ray per pixel).
+    /// Each mode's frame (truth: one ray per pixel), fast march.
     pub frame_ms: std::collections::BTreeMap<String, f64>,
+    /// The same with the reference march.
+    pub reference_ms: std::collections::BTreeMap<String, f64>,
 }
 
 impl BenchRow {
     fn ms(&self, mode: &str) -> f64 {
         self.frame_ms.get(mode).copied().unwrap_or(f64::NAN)
     }
+
+    fn reference(&self, mode: &str) -> f64 {
+        self.reference_ms.get(mode).copied().unwrap_or(f64::NAN)
+    }
 }
 
-/// `lodestone bench`: every preset × view angle × distance, each mode's frame time and the flat
-/// reference's, light 30° at azimuth 90°.
+/// `lodestone bench`: every preset × view angle × distance, each mode's frame time with the fast
+/// and the reference march, and the flat reference's, light 30° at azimuth 90°.
 pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Result<()> {
     let r = renderer()?;
     let (w, h) = cfg.size;
@@ -242,6 +252,8 @@ pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Re
     let mut rows = vec![];
     for (name, preset) in presets {
         let prepared = preset.prepare()?;
+        let mut reference = prepared.clone();
+        reference.surface.march = March::Reference;
         let mut flat_material = preset.clone();
         flat_material.material.heights.sigma_h = 0.0;
         let flat = flat_material.prepare()?;
@@ -254,26 +266,33 @@ pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Re
                     light_azimuth_deg: 90.0,
                     distance,
                     shape: Shape::Plane,
+                    march: March::Fast,
                 }
                 .scene();
                 let gm = GpuMaterial::new(r.context(), &prepared, scene.camera.target);
+                let gref = GpuMaterial::new(r.context(), &reference, scene.camera.target);
                 let gflat = GpuMaterial::new(r.context(), &flat, scene.camera.target);
                 let flat_ms =
                     frame_ms(&r, &mut target, &gflat, &scene, ViewMode::Naive, cfg.frames);
-                let frame_ms = BENCH_MODES
-                    .iter()
-                    .map(|(n, mode)| {
-                        target.reset();
-                        let ms = frame_ms(&r, &mut target, &gm, &scene, *mode, cfg.frames);
-                        ((*n).to_owned(), ms)
-                    })
-                    .collect();
+                let mut time = |g: &GpuMaterial| {
+                    BENCH_MODES
+                        .iter()
+                        .map(|(n, mode)| {
+                            target.reset();
+                            let ms = frame_ms(&r, &mut target, g, &scene, *mode, cfg.frames);
+                            ((*n).to_owned(), ms)
+                        })
+                        .collect()
+                };
+                let frame_ms = time(&gm);
+                let reference_ms = time(&gref);
                 rows.push(BenchRow {
                     preset: name.clone(),
                     view_deg,
                     distance,
                     flat_ms,
                     frame_ms,
+                    reference_ms,
                 });
             }
         }
@@ -294,6 +313,8 @@ pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Re
                 "flat_ms": row.flat_ms,
                 "frame_ms": row.frame_ms,
                 "over_flat": BENCH_MODES.iter().map(|(n, _)| ((*n).to_owned(), serde_json::json!(row.ms(n) / row.flat_ms))).collect::<serde_json::Map<_, _>>(),
+                "reference_march_ms": row.reference_ms,
+                "over_reference_march": BENCH_MODES.iter().map(|(n, _)| ((*n).to_owned(), serde_json::json!(row.ms(n) / row.reference(n)))).collect::<serde_json::Map<_, _>>(),
                 "filtered_over_naive": row.ms("filtered") / row.ms("naive"),
                 "truth_ns_per_ray": row.ms("truth") * 1e6 / pixels,
             })).collect::<Vec<_>>(),
@@ -302,11 +323,11 @@ pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Re
     } else {
         outln!(
             "{adapter}, {w}×{h}, median over {} batches of 8 frames (synchronised wall time); \
-             ×flat = frame time over the same view with σ_h = 0",
+             ×flat = frame time over the same view with σ_h = 0; /ref = fast march over the reference march",
             cfg.frames
         );
         outln!(
-            "{:<28} {:>5} {:>6} {:>9} {:>9} {:>6} {:>9} {:>9} {:>6} {:>9} {:>6} {:>9} {:>6}",
+            "{:<28} {:>5} {:>6} {:>9} {:>9} {:>6} {:>9} {:>9} {:>6} {:>6} {:>9} {:>6} {:>6} {:>9} {:>6}",
             "preset",
             "view",
             "dist",
@@ -316,8 +337,10 @@ pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Re
             "v-ind ms",
             "filt ms",
             "×flat",
+            "/ref",
             "truth ms",
             "×flat",
+            "/ref",
             "ns/ray",
             "f/n"
         );
@@ -330,13 +353,15 @@ pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Re
                 row.ms("truth"),
             );
             outln!(
-                "{:<28} {:>5.1} {:>6.2} {f:>9.2} {n:>9.2} {:>6.2} {v:>9.2} {fi:>9.2} {:>6.2} {t:>9.2} {:>6.2} {:>9.1} {:>6.2}",
+                "{:<28} {:>5.1} {:>6.2} {f:>9.2} {n:>9.2} {:>6.2} {v:>9.2} {fi:>9.2} {:>6.2} {:>6.2} {t:>9.2} {:>6.2} {:>6.2} {:>9.1} {:>6.2}",
                 short_name(&row.preset),
                 row.view_deg,
                 row.distance,
                 n / f,
                 fi / f,
+                fi / row.reference("filtered"),
                 t / f,
+                t / row.reference("truth"),
                 t * 1e6 / pixels,
                 fi / n
             );

@@ -392,6 +392,10 @@ fn bench_sweeps_presets_distances_and_views_against_the_flat_reference() {
             let ratio = row["over_flat"][mode].as_f64().unwrap();
             let want = ms.as_f64().unwrap() / row["flat_ms"].as_f64().unwrap();
             assert!((ratio - want).abs() <= 1e-12 * want, "{mode}: {row}");
+            assert!(positive(&row["reference_march_ms"][mode]), "{mode}: {row}");
+            let over_ref = row["over_reference_march"][mode].as_f64().unwrap();
+            let want = ms.as_f64().unwrap() / row["reference_march_ms"][mode].as_f64().unwrap();
+            assert!((over_ref - want).abs() <= 1e-12 * want, "{mode}: {row}");
         }
     }
     assert!(rows[0]["preset"].as_str().unwrap().ends_with("default.ron"));

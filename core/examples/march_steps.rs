@@ -15,7 +15,7 @@ use lodestone_core::material::Material;
 use lodestone_core::material::transfer::TransferFunction;
 use lodestone_core::math::random::splitmix;
 use lodestone_core::scene::direction::direction;
-use lodestone_core::scene::surface::{Surface, march_heightfield};
+use lodestone_core::scene::surface::{March, Surface, march_heightfield};
 use std::cell::Cell;
 use std::f64::consts::TAU;
 
@@ -75,12 +75,13 @@ fn main() {
                 count.set(count.get() + 1);
                 s.sigma_h * noise.value(x)
             };
-            let t_ref = march_heightfield(o, d, rate, s.h_max, s.min_step, height);
+            let t_ref =
+                march_heightfield(o, d, rate, s.h_max, s.min_step, March::Reference, height);
             n_ref += count.replace(0) - if t_ref.is_some() { 48 } else { 0 };
             // The same reference march started at the tightest honest top we know here.
             let top2 = s.sigma_h * max_abs * 1.05;
             let o2 = o + d * ((o.z - top2) / -d.z);
-            let t2 = march_heightfield(o2, d, rate, s.h_max, s.min_step, height);
+            let t2 = march_heightfield(o2, d, rate, s.h_max, s.min_step, March::Reference, height);
             n_tight += count.replace(0) - if t2.is_some() { 48 } else { 0 };
             // Second-order march.
             let u = dxy;

@@ -218,8 +218,8 @@ gpu_struct! {
         env_offset: u32 => "u32",
         /// 1 when there is an environment light.
         has_env: u32 => "u32",
-        /// Padding to 16 bytes.
-        pad: u32 => "u32",
+        /// How marches refine a crossing (`MARCH_*`, core's `scene::surface::March`).
+        march: u32 => "u32",
     }
 }
 

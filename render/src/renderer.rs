@@ -3,8 +3,8 @@
 
 use crate::gpu::GpuContext;
 use crate::gpu_codes::{
-    ColorCode, CombineCode, CorrelationCode, DriverCode, HeightFilterCode, ModeCode, ShapeCode,
-    TransferCode,
+    ColorCode, CombineCode, CorrelationCode, DriverCode, HeightFilterCode, MarchCode, ModeCode,
+    ShapeCode, TransferCode,
 };
 use crate::gpu_types::{MaterialParams, ViewParams};
 use crate::specialize::{SpecializeError, view_source_for};
@@ -23,6 +23,7 @@ use lodestone_core::microfacet::masking_shadowing::Correlation;
 use lodestone_core::microfacet::visible_slopes::slope_rule;
 use lodestone_core::scene::camera::{Camera, PIXEL_SIGMA};
 use lodestone_core::scene::shape::Shape;
+use lodestone_core::scene::surface::March;
 use std::collections::HashMap;
 use std::f64::consts::TAU;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -555,6 +556,11 @@ pub fn material_data_for(
     base.height_filter = match m.filtering.height_filter {
         HeightFilter::Exact => HeightFilterCode::Exact,
         HeightFilter::PaperFit => HeightFilterCode::PaperFit,
+    }
+    .code();
+    base.march = match s.march {
+        March::Reference => MarchCode::Reference,
+        March::Fast => MarchCode::Fast,
     }
     .code();
     base.g_mean = prepared.global_height.0 as f32;

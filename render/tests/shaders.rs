@@ -84,6 +84,8 @@ const MIRRORS: &[(&str, &str, &str, &str)] = &[
     ("scene/cylinder.wgsl", "cylinder_frame", "scene/cylinder.rs", "frame"),
     ("scene/cylinder.wgsl", "cylinder_intersect", "scene/cylinder.rs", "intersect"),
     ("eval/cylinder.wgsl", "cylinder_gap", "eval/cylinder.rs", "cylinder_march"),
+    ("eval/cylinder.wgsl", "cylinder_refine", "scene/surface.rs", "refine"),
+    ("scene/surface.wgsl", "gap_at", "scene/surface.rs", "march_heightfield"),
     ("scene/cylinder.wgsl", "tangent_footprint", "scene/cylinder.rs", "tangent_footprint"),
     ("eval/compiled.wgsl", "point_input", "eval/compiled.rs", "at_point"),
     ("eval/compiled.wgsl", "color_at", "eval/evaluator.rs", "color_at"),

@@ -30,6 +30,7 @@ impl Evaluator {
             self.cylinder_rate(r),
             s.min_step,
             |t| t > t_max,
+            s.march,
         )
     }
 

@@ -32,8 +32,14 @@ impl Evaluator {
     /// March `o + t·d` against h̄ (the same [`march_heightfield`] as the explicit surface).
     pub fn lod_march(&self, o: DVec3, d: DVec3, fp: Footprint) -> Option<f64> {
         let s = &self.surface;
-        march_heightfield(o, d, self.lod_rate(d, fp), s.h_max, s.min_step, |x| {
-            self.lod_height(x, fp)
-        })
+        march_heightfield(
+            o,
+            d,
+            self.lod_rate(d, fp),
+            s.h_max,
+            s.min_step,
+            s.march,
+            |x| self.lod_height(x, fp),
+        )
     }
 }

@@ -32,6 +32,22 @@ pub struct Surface {
     pub g_lip: f64,
     /// Minimum step length of the march.
     pub min_step: f64,
+    /// How marches on this surface (and on its level-of-detail surface) refine a crossing.
+    pub march: March,
+}
+
+/// How a march refines the crossing it brackets (the steps are the same): the selectable
+/// reference, and the fast path that replaces it (issue #15 measures one against the other).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum March {
+    /// Bisection of the bracket: 48 halvings in f64 (24 in the f32 WGSL).
+    Reference,
+    /// The Illinois method (a bracketed secant whose stale end is halved): the same bracket, refined
+    /// until it is as narrow as the reference's (or at the precision of t), typically in 5–8
+    /// evaluations instead of 48 (24 on the GPU). It keeps the bracket, so it returns a point
+    /// above the surface within the same crossing interval as the reference.
+    #[default]
+    Fast,
 }
 
 /// Result of marching a ray.
@@ -70,6 +86,7 @@ impl Surface {
             transfer,
             h_max: sigma_h * g_abs_max,
             min_step,
+            march: March::default(),
         }
     }
 
@@ -110,7 +127,8 @@ impl Surface {
             0.0
         };
         let rate = d.z.abs() + k * r;
-        match march_heightfield(o, d, rate, self.h_max, self.min_step, |x| self.height(x)) {
+        let height = |x| self.height(x);
+        match march_heightfield(o, d, rate, self.h_max, self.min_step, self.march, height) {
             Some(t) => Trace::Hit(t),
             None => Trace::Escape,
         }
@@ -139,12 +157,14 @@ pub const RELAXATION: f64 = 1.6;
 /// a crossing. Steps are at least `min_step`; a sign change is refined by 48 bisections, returning the
 /// last point above the surface. A negative gap at t = 0 is rounding (the origin is on the surface by
 /// contract). `None` when the ray leaves the slab. Shared by the explicit and the level-of-detail surface.
+/// `march` chooses how the crossing is refined ([`March`]).
 pub fn march_heightfield(
     o: DVec3,
     d: DVec3,
     rate: f64,
     h_max: f64,
     min_step: f64,
+    march: March,
     height: impl Fn(DVec2) -> f64,
 ) -> Option<f64> {
     let top = h_max * (1.0 + 1e-12) + 1e-300;
@@ -159,6 +179,7 @@ pub fn march_heightfield(
             let z = o.z + d.z * t;
             (d.z >= 0.0 && z > top) || (d.z < 0.0 && z < -top - 1.0)
         },
+        march,
     )
 }
 
@@ -166,17 +187,18 @@ pub fn march_heightfield(
 /// gap along the ray (≥ 0 outside), `rate` a bound on |d gap/dt|, `left(t)` says the ray has left
 /// the region where the surface can be. Rules as in [`march_heightfield`]: relaxed steps back off
 /// when the safe intervals do not cover them, steps are at least `min_step`, a sign change is refined
-/// by 48 bisections (returning the last point above), a negative gap at t = 0 is rounding.
+/// ([`refine`], by `march`) returning the last point above, a negative gap at t = 0 is rounding.
 pub fn sphere_trace(
     gap: impl Fn(f64) -> f64,
     rate: f64,
     min_step: f64,
     left: impl Fn(f64) -> bool,
+    march: March,
 ) -> Option<f64> {
     if !(rate > 0.0) {
         return None;
     }
-    let (mut t, mut prev_t, mut prev_r) = (0.0_f64, 0.0_f64, 0.0_f64);
+    let (mut t, mut prev_t, mut prev_r, mut prev_g) = (0.0_f64, 0.0_f64, 0.0_f64, 0.0_f64);
     let mut relaxed = false;
     for _ in 0..1_000_000 {
         let mut g = gap(t);
@@ -194,8 +216,34 @@ pub fn sphere_trace(
             return None;
         }
         if g < 0.0 {
-            let (mut a, mut b) = (prev_t, t);
-            for _ in 0..48 {
+            return Some(refine(&gap, (prev_t, prev_g), (t, g), march));
+        }
+        prev_t = t;
+        prev_r = r;
+        prev_g = g;
+        let safe = r.max(min_step);
+        let step = (RELAXATION * r).max(min_step);
+        relaxed = step > safe;
+        t += step;
+    }
+    None
+}
+
+/// The crossing in the bracket `a` (gap ≥ 0) to `b` (gap < 0): the last point found with gap ≥ 0,
+/// at most the reference's final bracket width (`(b − a)/2⁴⁸`, or the precision of t) before the
+/// crossing. [`March::Reference`] bisects 48 times; [`March::Fast`] runs the Illinois method
+/// (regula falsi whose end that stays put twice has its gap halved), which keeps the bracket, falls
+/// back to the midpoint when the secant leaves it, and stops at the same width.
+pub fn refine(
+    gap: &impl Fn(f64) -> f64,
+    (mut a, mut ga): (f64, f64),
+    (mut b, mut gb): (f64, f64),
+    march: March,
+) -> f64 {
+    const HALVINGS: i32 = 48;
+    match march {
+        March::Reference => {
+            for _ in 0..HALVINGS {
                 let m = 0.5 * (a + b);
                 if gap(m) >= 0.0 {
                     a = m;
@@ -203,16 +251,37 @@ pub fn sphere_trace(
                     b = m;
                 }
             }
-            return Some(a);
+            a
         }
-        prev_t = t;
-        prev_r = r;
-        let safe = r.max(min_step);
-        let step = (RELAXATION * r).max(min_step);
-        relaxed = step > safe;
-        t += step;
+        March::Fast => {
+            let width = ((b - a) * 0.5f64.powi(HALVINGS)).max(f64::EPSILON * b.abs());
+            let mut side = 0;
+            for _ in 0..2 * HALVINGS {
+                if b - a <= width {
+                    break;
+                }
+                let mut c = (a * gb - b * ga) / (gb - ga);
+                if !(c > a && c < b) {
+                    c = 0.5 * (a + b);
+                }
+                let gc = gap(c);
+                if gc >= 0.0 {
+                    (a, ga) = (c, gc);
+                    if side == 1 {
+                        gb *= 0.5;
+                    }
+                    side = 1;
+                } else {
+                    (b, gb) = (c, gc);
+                    if side == -1 {
+                        ga *= 0.5;
+                    }
+                    side = -1;
+                }
+            }
+            a
+        }
     }
-    None
 }
 
 #[cfg(test)]
@@ -289,5 +358,55 @@ mod tests {
             "the lowest pit cannot see the horizon"
         );
         assert!(!s.sees(DVec3::new(lo.1.x, lo.1.y, lo.0), DVec3::new(1.0, 0.0, -0.1)));
+    }
+
+    /// Both refinements find the same crossing (to the reference's bracket width) on 400 rays from
+    /// 30° to 88°, the fast one in a fraction of the reference's 48 evaluations.
+    #[test]
+    fn fast_refinement_finds_the_reference_crossing_in_fewer_evaluations() {
+        use std::cell::Cell;
+        let s = surface();
+        let evals = Cell::new(0usize);
+        let height = |x: DVec2| {
+            evals.set(evals.get() + 1);
+            s.height(x)
+        };
+        let (mut fast_evals, mut ref_evals, mut hits) = (0, 0, 0);
+        for i in 0..400 {
+            let theta = (30.0 + 58.0 * (i % 20) as f64 / 19.0).to_radians();
+            let phi = 0.7 * i as f64;
+            let d = -crate::scene::direction::direction(theta, phi);
+            let o = DVec3::new(0.31 * i as f64, -0.17 * i as f64, s.h_max + 0.01);
+            let rate = d.z.abs()
+                + s.sigma_h
+                    * s.g_lip
+                    * s.lipschitz_along(DVec2::new(d.x, d.y).normalize())
+                    * d.x.hypot(d.y);
+            let run = |march| {
+                evals.set(0);
+                let t = march_heightfield(o, d, rate, s.h_max, s.min_step, march, height);
+                (t, evals.get())
+            };
+            let (tr, nr) = run(March::Reference);
+            let (tf, nf) = run(March::Fast);
+            let (Some(tr), Some(tf)) = (tr, tf) else {
+                panic!("downward rays hit: {tr:?} {tf:?}")
+            };
+            assert!(
+                (tr - tf).abs() <= 1e-12 * tr.max(1.0),
+                "ray {i}: {tr} vs {tf}"
+            );
+            let p = o + d * tf;
+            assert!(
+                p.z - s.height(DVec2::new(p.x, p.y)) >= 0.0,
+                "fast returns a point above"
+            );
+            ref_evals += nr;
+            fast_evals += nf;
+            hits += 1;
+        }
+        let saved = (ref_evals - fast_evals) as f64 / hits as f64;
+        eprintln!("refinement evaluations saved per hit: {saved:.1} of 48");
+        assert!(saved > 30.0, "saved only {saved:.1} evaluations per hit");
     }
 }
