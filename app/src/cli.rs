@@ -196,7 +196,7 @@ pub enum RenderMode {
     All,
 }
 
-/// How marches refine the crossing they find (`lodestone_core::scene::surface::March`).
+/// How marches refine the crossing they find (`lodestone_core::scene::march::March`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum MarchArg {
     /// Bisection, 48 halvings on the CPU and 24 on the GPU (the reference).
@@ -207,10 +207,10 @@ pub enum MarchArg {
 
 impl MarchArg {
     /// The core value.
-    pub fn march(self) -> lodestone_core::scene::surface::March {
+    pub fn march(self) -> lodestone_core::scene::march::March {
         match self {
-            Self::Reference => lodestone_core::scene::surface::March::Reference,
-            Self::Fast => lodestone_core::scene::surface::March::Fast,
+            Self::Reference => lodestone_core::scene::march::March::Reference,
+            Self::Fast => lodestone_core::scene::march::March::Fast,
         }
     }
 }

@@ -211,7 +211,7 @@ fn run(cli: Cli) -> Result<()> {
                 light_azimuth_deg,
                 distance: 6.0,
                 shape: shape.shape(2.0).map_err(anyhow::Error::msg)?,
-                march: lodestone_core::scene::surface::March::default(),
+                march: lodestone_core::scene::march::March::default(),
             };
             let opts = inspect::Options {
                 view,

@@ -5,8 +5,8 @@ use crate::preset_io::Resolved;
 use anyhow::{Context, Result, bail};
 use lodestone_core::scene::camera::Camera;
 use lodestone_core::scene::direction::direction;
+use lodestone_core::scene::march::March;
 use lodestone_core::scene::shape::Shape;
-use lodestone_core::scene::surface::March;
 use lodestone_render::error_map::{abs_difference, error_stats, heat_map};
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,

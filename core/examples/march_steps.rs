@@ -15,7 +15,8 @@ use lodestone_core::material::Material;
 use lodestone_core::material::transfer::TransferFunction;
 use lodestone_core::math::random::splitmix;
 use lodestone_core::scene::direction::direction;
-use lodestone_core::scene::surface::{March, Surface, march_heightfield};
+use lodestone_core::scene::march::{March, march_heightfield};
+use lodestone_core::scene::surface::Surface;
 use std::cell::Cell;
 use std::f64::consts::TAU;
 

@@ -9,7 +9,7 @@ use lodestone_core::microfacet::effective_height::{
     FIT_ALPHA_MU, FIT_ALPHA_SIGMA, FIT_BETA_MU, FIT_BETA_SIGMA,
 };
 use lodestone_core::microfacet::masking_shadowing::AZIMUTH_CORRELATION;
-use lodestone_core::scene::surface::RELAXATION;
+use lodestone_core::scene::march::RELAXATION;
 use std::fmt::Write;
 use std::sync::LazyLock;
 
@@ -123,7 +123,7 @@ gpu_enum! {
 }
 
 gpu_enum! {
-    /// `params.march`: `lodestone_core::scene::surface::March`.
+    /// `params.march`: `lodestone_core::scene::march::March`.
     MarchCode {
         /// Bisection (24 halvings in f32).
         Reference = 0 => "MARCH_REFERENCE",

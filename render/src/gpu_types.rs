@@ -218,7 +218,7 @@ gpu_struct! {
         env_offset: u32 => "u32",
         /// 1 when there is an environment light.
         has_env: u32 => "u32",
-        /// How marches refine a crossing (`MARCH_*`, core's `scene::surface::March`).
+        /// How marches refine a crossing (`MARCH_*`, core's `scene::march::March`).
         march: u32 => "u32",
     }
 }

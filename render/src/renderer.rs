@@ -22,8 +22,8 @@ use lodestone_core::microfacet::effective_height::{EffectiveHeightTable, HeightF
 use lodestone_core::microfacet::masking_shadowing::Correlation;
 use lodestone_core::microfacet::visible_slopes::slope_rule;
 use lodestone_core::scene::camera::{Camera, PIXEL_SIGMA};
+use lodestone_core::scene::march::March;
 use lodestone_core::scene::shape::Shape;
-use lodestone_core::scene::surface::March;
 use std::collections::HashMap;
 use std::f64::consts::TAU;
 use std::sync::{Arc, Mutex, OnceLock};

@@ -416,7 +416,7 @@ fn image_driver_views_match_core() {
 /// the two refinements settle on neighbouring facets.
 #[test]
 fn fast_and_reference_marches_render_the_same_images() {
-    use lodestone_core::scene::surface::March;
+    use lodestone_core::scene::march::March;
     let Some(r) = renderer() else { return };
     let (w, h) = (64, 40);
     for (name, shape) in [

@@ -253,7 +253,7 @@ pub(crate) mod tests {
         for w in &mut waves {
             w.amplitude /= norm;
         }
-        SumOfSines { waves }
+        SumOfSines { waves, octaves: 1 }
     }
 
     /// The same field sampled into a `n`×`n` image over one tile.

@@ -59,6 +59,31 @@ impl NoiseParams {
     pub const MAX_COMPONENTS: u32 = 256;
 }
 
+/// At most this many nested octave levels in the fast march ([`crate::scene::octave_march`]; the GPU carries their ends in a `vec4<u32>`); more octaves are
+/// grouped.
+pub const MAX_LEVELS: usize = 4;
+
+/// The ends of the nested levels of `n` waves in `octaves` octaves (wave `i` is in octave
+/// `i·octaves/n`, as [`SumOfSines::new`] lays them out), at most
+/// [`MAX_LEVELS`], the last always `n`. Edge cases: `n = 0` gives `[0]`; one octave gives `[n]`.
+pub fn level_ends(n: usize, octaves: usize) -> Vec<usize> {
+    let octaves = octaves.max(1);
+    let groups = octaves.min(MAX_LEVELS);
+    let mut ends: Vec<usize> = (1..=groups)
+        .map(|g| {
+            // The first wave of octave ⌈g·octaves/groups⌉: the smallest i with i·octaves/n ≥ that.
+            let o = (g * octaves).div_ceil(groups);
+            (o * n).div_ceil(octaves).min(n)
+        })
+        .filter(|&e| e > 0)
+        .collect();
+    ends.dedup();
+    if ends.last() != Some(&n) {
+        ends.push(n);
+    }
+    ends
+}
+
 /// One sinusoid `a cos(2π k·x + φ)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Wave {
@@ -73,8 +98,10 @@ pub struct Wave {
 /// A realised sum of sinusoids.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SumOfSines {
-    /// The components.
+    /// The components, coarse octave first.
     pub waves: Vec<Wave>,
+    /// The number of octaves the waves are spread over (wave `i` is in octave `i·octaves/n`).
+    pub octaves: usize,
 }
 
 /// Symmetric square root of a symmetric positive semi-definite 2×2 matrix (closed form).
@@ -125,7 +152,7 @@ impl SumOfSines {
         for w in &mut waves {
             w.amplitude *= norm;
         }
-        let mut me = Self { waves };
+        let mut me = Self { waves, octaves };
         // Exact gradient covariance: k ↦ T^{1/2} G^{−1/2} k.
         let target = {
             let t = grad_cov.to_mat();
@@ -214,6 +241,12 @@ impl SumOfSines {
         }
     }
 
+    /// The ends of the fast march's nested octave levels
+    /// ([`level_ends`]).
+    pub fn level_ends(&self) -> Vec<usize> {
+        level_ends(self.waves.len(), self.octaves)
+    }
+
     /// `Σ|a_i|`: a bound on |f| (and on |f̄| at any footprint).
     pub fn amplitude_bound(&self) -> f64 {
         self.waves.iter().map(|w| w.amplitude.abs()).sum()
@@ -236,6 +269,30 @@ impl SumOfSines {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn levels_follow_octaves_and_end_at_n() {
+        assert_eq!(level_ends(48, 3), vec![16, 32, 48]);
+        assert_eq!(level_ends(64, 3), vec![22, 43, 64]);
+        assert_eq!(level_ends(48, 1), vec![48]);
+        assert_eq!(level_ends(0, 3), vec![0]);
+        assert_eq!(level_ends(2, 3), vec![1, 2]);
+        // 8 octaves grouped into 4 levels of 2.
+        assert_eq!(level_ends(64, 8), vec![16, 32, 48, 64]);
+        // 6 octaves into 4: boundaries at octaves 2, 3, 5.
+        assert_eq!(level_ends(60, 6), vec![20, 30, 50, 60]);
+        for n in 0..70 {
+            for o in 1..13 {
+                let e = level_ends(n, o);
+                assert!(e.len() <= MAX_LEVELS && *e.last().unwrap() == n);
+                assert!(e.windows(2).all(|w| w[0] < w[1]), "{n} {o} {e:?}");
+                // Every boundary is an octave boundary.
+                for &b in &e[..e.len() - 1] {
+                    assert_ne!((b - 1) * o / n, b * o / n, "{n} {o} {e:?}");
+                }
+            }
+        }
+    }
 
     fn noise(target: SlopeCov) -> SumOfSines {
         SumOfSines::new(

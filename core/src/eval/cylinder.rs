@@ -6,7 +6,7 @@ use crate::eval::{Evaluator, Method};
 use crate::microfacet::slopes::normal_of;
 use crate::scene::camera::Camera;
 use crate::scene::cylinder::{frame, intersect, local, to_surface, to_tangent};
-use crate::scene::surface::sphere_trace;
+use crate::scene::march::sphere_trace;
 use glam::{DMat3, DVec2, DVec3};
 
 impl Evaluator {

@@ -2,9 +2,10 @@
 //! noise's attenuated waves, or the image's pyramid, through the transfer function's mean), marched
 //! with a rigorous rate bound.
 
+use crate::driver::field::DriverField;
 use crate::driver::footprint::Footprint;
 use crate::eval::Evaluator;
-use crate::scene::surface::march_heightfield;
+use crate::scene::march::march_heightfield;
 use glam::{DVec2, DVec3};
 
 impl Evaluator {
@@ -32,6 +33,21 @@ impl Evaluator {
     /// March `o + t·d` against h̄ (the same [`march_heightfield`] as the explicit surface).
     pub fn lod_march(&self, o: DVec3, d: DVec3, fp: Footprint) -> Option<f64> {
         let s = &self.surface;
+        if let DriverField::Noise(n) = &s.driver {
+            let att: Vec<f64> = n.waves.iter().map(|w| n.attenuation(w, fp)).collect();
+            if let Some(os) = s.octaves(Some(&att)) {
+                // σ_f is the phase average, the same everywhere (DriverField::lod_moments).
+                let var: f64 = n
+                    .waves
+                    .iter()
+                    .zip(&att)
+                    .map(|(w, g)| w.amplitude * w.amplitude * (1.0 - g * g) / 2.0)
+                    .sum();
+                let sf = var.max(0.0).sqrt();
+                let height_of = |m| s.sigma_h * self.transfer.moments(m, sf).mean;
+                return os.march(o, d, height_of, s.march);
+            }
+        }
         march_heightfield(
             o,
             d,

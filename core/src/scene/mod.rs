@@ -5,5 +5,7 @@
 pub mod camera;
 pub mod cylinder;
 pub mod direction;
+pub mod march;
+pub mod octave_march;
 pub mod shape;
 pub mod surface;

@@ -2,19 +2,15 @@
 //! [`DriverField`]), and ray marching on it that cannot step over a feature. This is what the ground
 //! truth renders: no statistics here.
 //!
-//! Step rule (sphere tracing for heightfields, docs/design.md): along a ray `p(t) = o + t·d`, the gap
-//! `z(t) − h(x(t))` changes at most at rate `|d_z| + K_d |d_xy|`, where
-//! `K_d = σ_h · max|g′| · L_f(d̂_xy)` bounds the slope of h along the ray's horizontal direction
-//! (`L_f = Σ|a_i| 2π |k_i·d̂|` for the noise, the texel differences for an image,
-//! [`DriverField::lipschitz_along`]). So the step `Δt = gap/(|d_z| + K_d|d_xy|)` can never cross the surface. To bound the
-//! work where a ray skims the surface, steps are at least `Δ_min = 1e-4 × (shortest wavelength or texel)`;
-//! a sign change of the gap is then refined by 48 bisections. A feature can be missed only if it
-//! pokes through the ray over less than Δ_min (≈ 1e-4 of the finest wavelength), i.e. never in
-//! practice. Rays stop once above `h_max = σ_h·max|g|` (rigorous bound).
+//! The march ([`Surface::march`]) is the fast octave march for a noise driver
+//! ([`crate::scene::octave_march`]) or the reference sphere tracing with the global Lipschitz
+//! bound `K_d = σ_h · max|g′| · L_f(d̂_xy)` ([`crate::scene::march`]), as [`March`] selects.
 
 use crate::driver::field::DriverField;
 use crate::material::Material;
 use crate::material::transfer::TransferFunction;
+use crate::scene::march::{March, march_heightfield};
+use crate::scene::octave_march::OctaveSurface;
 use glam::{DVec2, DVec3};
 
 /// The explicit heightfield of a material.
@@ -32,22 +28,11 @@ pub struct Surface {
     pub g_lip: f64,
     /// Minimum step length of the march.
     pub min_step: f64,
-    /// How marches on this surface (and on its level-of-detail surface) refine a crossing.
+    /// How marches on this surface (and on its level-of-detail surface) step and refine a crossing.
     pub march: March,
-}
-
-/// How a march refines the crossing it brackets (the steps are the same): the selectable
-/// reference, and the fast path that replaces it (issue #15 measures one against the other).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum March {
-    /// Bisection of the bracket: 48 halvings in f64 (24 in the f32 WGSL).
-    Reference,
-    /// The Illinois method (a bracketed secant whose stale end is halved): the same bracket, refined
-    /// until it is as narrow as the reference's (or at the precision of t), typically in 5–8
-    /// evaluations instead of 48 (24 on the GPU). It keeps the bracket, so it returns a point
-    /// above the surface within the same crossing interval as the reference.
-    #[default]
-    Fast,
+    /// The nested octave levels of a noise driver's fast march ([`SumOfSines::level_ends`]; empty
+    /// for an image).
+    pub levels: Vec<usize>,
 }
 
 /// Result of marching a ray.
@@ -79,7 +64,12 @@ impl Surface {
             TransferFunction::Curve(c) => c.points.iter().map(|p| p[1].abs()).fold(0.0, f64::max),
         };
         let min_step = 1e-4 * driver.finest_scale();
+        let levels = match &driver {
+            DriverField::Noise(n) => n.level_ends(),
+            DriverField::Image(_) => Vec::new(),
+        };
         Self {
+            levels,
             g_lip: transfer.max_derivative(),
             driver,
             sigma_h,
@@ -119,6 +109,13 @@ impl Surface {
     /// crossing. `o` must be on or above the surface; a negative gap at `o` itself is taken as rounding
     /// (a shadow ray leaving a hit point), never as a crossing.
     pub fn march(&self, o: DVec3, d: DVec3) -> Trace {
+        if let Some(os) = self.octaves(None) {
+            let height_of = |f| self.sigma_h * self.transfer.eval(f);
+            return match os.march(o, d, height_of, self.march) {
+                Some(t) => Trace::Hit(t),
+                None => Trace::Escape,
+            };
+        }
         let dxy = DVec2::new(d.x, d.y);
         let r = dxy.length();
         let k = if r > 0.0 {
@@ -134,6 +131,24 @@ impl Surface {
         }
     }
 
+    /// The octave march's view of this surface (its waves times `attenuation`, for the
+    /// level-of-detail surface), when it marches fast on a noise driver.
+    pub fn octaves<'a>(&'a self, attenuation: Option<&'a [f64]>) -> Option<OctaveSurface<'a>> {
+        let DriverField::Noise(n) = &self.driver else {
+            return None;
+        };
+        (self.march == March::Fast).then_some(OctaveSurface {
+            waves: &n.waves,
+            attenuation,
+            ends: &self.levels,
+            sigma_h: self.sigma_h,
+            g_lip: self.g_lip,
+            linear: matches!(self.transfer, TransferFunction::Identity),
+            h_max: self.h_max,
+            min_step: self.min_step,
+        })
+    }
+
     /// Whether the point p (on the surface) sees direction d (unit): false if d is at or below the
     /// horizon or the ray toward d hits the surface.
     pub fn sees(&self, p: DVec3, d: DVec3) -> bool {
@@ -141,146 +156,6 @@ impl Surface {
             return false;
         }
         matches!(self.march(p, d), Trace::Escape)
-    }
-}
-
-/// Over-relaxation factor of the march (after Keinert et al. 2014, "Enhanced Sphere Tracing").
-pub const RELAXATION: f64 = 1.6;
-
-/// Sphere tracing on any heightfield `height` bounded by |h| ≤ `h_max`, along `p(t) = o + t·d`,
-/// with `rate` a bound on how fast the gap `z − h` can change per unit t (see the module docs).
-///
-/// At a point with gap g ≥ 0 no crossing lies within `g/rate` on either side. Steps are over-relaxed
-/// (`RELAXATION·g/rate`); before anything else is concluded at the new point (a hit, or leaving the
-/// slab), the safe intervals of the two points must cover everything between them, otherwise the march
-/// backs off to the end of the previous safe interval and steps unrelaxed — so relaxation never skips
-/// a crossing. Steps are at least `min_step`; a sign change is refined by 48 bisections, returning the
-/// last point above the surface. A negative gap at t = 0 is rounding (the origin is on the surface by
-/// contract). `None` when the ray leaves the slab. Shared by the explicit and the level-of-detail surface.
-/// `march` chooses how the crossing is refined ([`March`]).
-pub fn march_heightfield(
-    o: DVec3,
-    d: DVec3,
-    rate: f64,
-    h_max: f64,
-    min_step: f64,
-    march: March,
-    height: impl Fn(DVec2) -> f64,
-) -> Option<f64> {
-    let top = h_max * (1.0 + 1e-12) + 1e-300;
-    sphere_trace(
-        |t| {
-            let p = o + d * t;
-            p.z - height(DVec2::new(p.x, p.y))
-        },
-        rate,
-        min_step,
-        |t| {
-            let z = o.z + d.z * t;
-            (d.z >= 0.0 && z > top) || (d.z < 0.0 && z < -top - 1.0)
-        },
-        march,
-    )
-}
-
-/// The over-relaxed sphere tracing shared by every surface: `gap(t)` is the signed distance-like
-/// gap along the ray (≥ 0 outside), `rate` a bound on |d gap/dt|, `left(t)` says the ray has left
-/// the region where the surface can be. Rules as in [`march_heightfield`]: relaxed steps back off
-/// when the safe intervals do not cover them, steps are at least `min_step`, a sign change is refined
-/// ([`refine`], by `march`) returning the last point above, a negative gap at t = 0 is rounding.
-pub fn sphere_trace(
-    gap: impl Fn(f64) -> f64,
-    rate: f64,
-    min_step: f64,
-    left: impl Fn(f64) -> bool,
-    march: March,
-) -> Option<f64> {
-    if !(rate > 0.0) {
-        return None;
-    }
-    let (mut t, mut prev_t, mut prev_r, mut prev_g) = (0.0_f64, 0.0_f64, 0.0_f64, 0.0_f64);
-    let mut relaxed = false;
-    for _ in 0..1_000_000 {
-        let mut g = gap(t);
-        if g < 0.0 && t == 0.0 {
-            g = 0.0;
-        }
-        let r = g.max(0.0) / rate;
-        if relaxed && t - prev_t > prev_r + r {
-            // The relaxed step left a stretch no safe interval covers: back off and step safely.
-            t = prev_t + prev_r.max(min_step);
-            relaxed = false;
-            continue;
-        }
-        if left(t) {
-            return None;
-        }
-        if g < 0.0 {
-            return Some(refine(&gap, (prev_t, prev_g), (t, g), march));
-        }
-        prev_t = t;
-        prev_r = r;
-        prev_g = g;
-        let safe = r.max(min_step);
-        let step = (RELAXATION * r).max(min_step);
-        relaxed = step > safe;
-        t += step;
-    }
-    None
-}
-
-/// The crossing in the bracket `a` (gap ≥ 0) to `b` (gap < 0): the last point found with gap ≥ 0,
-/// at most the reference's final bracket width (`(b − a)/2⁴⁸`, or the precision of t) before the
-/// crossing. [`March::Reference`] bisects 48 times; [`March::Fast`] runs the Illinois method
-/// (regula falsi whose end that stays put twice has its gap halved), which keeps the bracket, falls
-/// back to the midpoint when the secant leaves it, and stops at the same width.
-pub fn refine(
-    gap: &impl Fn(f64) -> f64,
-    (mut a, mut ga): (f64, f64),
-    (mut b, mut gb): (f64, f64),
-    march: March,
-) -> f64 {
-    const HALVINGS: i32 = 48;
-    match march {
-        March::Reference => {
-            for _ in 0..HALVINGS {
-                let m = 0.5 * (a + b);
-                if gap(m) >= 0.0 {
-                    a = m;
-                } else {
-                    b = m;
-                }
-            }
-            a
-        }
-        March::Fast => {
-            let width = ((b - a) * 0.5f64.powi(HALVINGS)).max(f64::EPSILON * b.abs());
-            let mut side = 0;
-            for _ in 0..2 * HALVINGS {
-                if b - a <= width {
-                    break;
-                }
-                let mut c = (a * gb - b * ga) / (gb - ga);
-                if !(c > a && c < b) {
-                    c = 0.5 * (a + b);
-                }
-                let gc = gap(c);
-                if gc >= 0.0 {
-                    (a, ga) = (c, gc);
-                    if side == 1 {
-                        gb *= 0.5;
-                    }
-                    side = 1;
-                } else {
-                    (b, gb) = (c, gc);
-                    if side == -1 {
-                        ga *= 0.5;
-                    }
-                    side = -1;
-                }
-            }
-            a
-        }
     }
 }
 
