@@ -79,7 +79,7 @@ pub enum Command {
         /// Formats written by `--mode all`.
         #[arg(long, value_enum, default_value_t = Formats::Both)]
         formats: Formats,
-        /// How the ray marches refine a crossing (the reference stays selectable).
+        /// How the ray marches step and refine a crossing (the reference stays selectable).
         #[arg(long, value_enum, default_value_t = MarchArg::Fast)]
         march: MarchArg,
     },
@@ -168,6 +168,9 @@ pub enum Command {
         /// Timing repeats (the median is reported).
         #[arg(long, default_value_t = 5)]
         repeats: u32,
+        /// How the ray marches step and refine a crossing (the reference stays selectable).
+        #[arg(long, value_enum, default_value_t = MarchArg::Fast)]
+        march: MarchArg,
     },
     /// Run stiff and extreme cases (grazing angles, σ → 0 and 1e6, anisotropy 1e±6, L to 1e12, step
     /// maps, vertical transfer segments, constant images) through core f64, its f32 mirror and the
@@ -196,12 +199,12 @@ pub enum RenderMode {
     All,
 }
 
-/// How marches refine the crossing they find (`lodestone_core::scene::march::March`).
+/// How marches step and refine the crossing they find (`lodestone_core::scene::march::March`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum MarchArg {
-    /// Bisection, 48 halvings on the CPU and 24 on the GPU (the reference).
+    /// Global Lipschitz steps and bisection, 48 halvings on the CPU and 24 on the GPU (the reference).
     Reference,
-    /// The Illinois method to the same bracket width.
+    /// The octave march (noise drivers) and the Illinois method to the same bracket width.
     Fast,
 }
 

@@ -236,6 +236,7 @@ fn run(cli: Cli) -> Result<()> {
             views,
             zooms,
             repeats,
+            march,
         }) => {
             let opts = report::Options {
                 size,
@@ -243,6 +244,7 @@ fn run(cli: Cli) -> Result<()> {
                 views,
                 zooms,
                 repeats,
+                march: march.march(),
             };
             let rep = report::run(&preset, &opts)?;
             report::write(&rep, &out)?;

@@ -44,6 +44,8 @@ pub struct Options {
     pub zooms: Vec<f64>,
     /// Timing repeats (median).
     pub repeats: u32,
+    /// How every march steps and refines (the fast march, or the reference for comparison).
+    pub march: lodestone_core::scene::march::March,
 }
 
 impl Default for Options {
@@ -54,6 +56,7 @@ impl Default for Options {
             views: vec![0.0, 30.0, 60.0, 75.0, 85.0, 89.0],
             zooms: vec![1.5, 6.0, 40.0],
             repeats: 5,
+            march: lodestone_core::scene::march::March::Fast,
         }
     }
 }
@@ -203,6 +206,10 @@ pub fn run_with(
             ..preset.clone()
         }
         .prepare()
+        .map(|mut e| {
+            e.surface.march = opts.march;
+            e
+        })
     };
     let (p_exact, p_paper) = (prepare(&exact)?, prepare(&paper)?);
     let target = [0.3, 0.7];

@@ -125,9 +125,9 @@ gpu_enum! {
 gpu_enum! {
     /// `params.march`: `lodestone_core::scene::march::March`.
     MarchCode {
-        /// Bisection (24 halvings in f32).
+        /// Global Lipschitz steps, bisection (24 halvings in f32).
         Reference = 0 => "MARCH_REFERENCE",
-        /// The Illinois method to the same bracket width.
+        /// The octave march for a noise driver; the Illinois method to the same bracket width.
         Fast = 1 => "MARCH_FAST",
     }
 }

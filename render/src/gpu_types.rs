@@ -218,8 +218,14 @@ gpu_struct! {
         env_offset: u32 => "u32",
         /// 1 when there is an environment light.
         has_env: u32 => "u32",
-        /// How marches refine a crossing (`MARCH_*`, core's `scene::march::March`).
+        /// How marches step and refine a crossing (`MARCH_*`, core's `scene::march::March`).
         march: u32 => "u32",
+        /// Nested octave levels of the fast march (core's `noise::level_ends`, at most 4).
+        level_count: u32 => "u32",
+        /// The first three levels' ends, eight bits each (the last level ends at `wave_count`).
+        level_ends: u32 => "u32",
+        /// Padding to WGSL's 16-byte struct size.
+        pad: [u32; 2] => "vec2<u32>",
     }
 }
 
@@ -235,7 +241,8 @@ mod tests {
         assert_eq!(
             w.matches(": u32,").count()
                 + w.matches(": f32,").count()
-                + w.matches(": vec3<f32>,").count(),
+                + w.matches(": vec3<f32>,").count()
+                + w.matches(": vec2<u32>,").count(),
             MaterialParams::FIELDS.len()
         );
         assert!(w.contains("    sigma_h: f32,"));

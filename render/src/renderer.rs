@@ -417,6 +417,14 @@ pub fn material_data_for(
                 data.extend([w.k.x as f32, w.k.y as f32, w.amplitude as f32, phase as f32]);
             }
             base.wave_count = noise.waves.len() as u32;
+            let ends = &s.levels;
+            base.level_count = ends.len() as u32;
+            base.level_ends = ends
+                .iter()
+                .take(ends.len().saturating_sub(1))
+                .enumerate()
+                .map(|(l, &e)| (e.min(255) as u32) << (8 * l))
+                .sum();
         }
         DriverField::Image(tiled) => push_image(&mut data, &mut base, tiled, target),
     }

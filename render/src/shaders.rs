@@ -42,6 +42,8 @@ pub const MATERIAL_FILES: &[(&str, &str)] = wgsl_files![
     "driver/noise.wgsl",
     "driver/field.wgsl",
     "scene/direction.wgsl",
+    "scene/march.wgsl",
+    "scene/octave_march.wgsl",
     "scene/surface.wgsl",
     "eval/compiled.wgsl",
     "eval/query.wgsl",

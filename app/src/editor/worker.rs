@@ -265,6 +265,7 @@ impl State {
         }
         match Evaluator::with_image(material, image.clone(), self.prepared.as_ref()) {
             Ok(mut p) => {
+                p.surface.march = march_setting();
                 if let Some(sh) = environment {
                     p.set_environment_radiance(sh);
                 }
@@ -431,6 +432,17 @@ impl State {
         };
         self.truth = Some(target);
         result
+    }
+}
+
+/// The hidden editor setting for the march (issue #15: every speed-up is a ratio measured in one
+/// run): `LODESTONE_MARCH=reference` renders the views with the reference march, anything else (or
+/// nothing) with the fast one.
+fn march_setting() -> lodestone_core::scene::march::March {
+    use lodestone_core::scene::march::March;
+    match std::env::var("LODESTONE_MARCH").as_deref() {
+        Ok("reference") => March::Reference,
+        _ => March::Fast,
     }
 }
 

@@ -1,7 +1,7 @@
 //! The fast march of a sum of sinusoids ([`March::Fast`] on noise-driven surfaces, explicit and
 //! level-of-detail): nested octave levels, each stepping by the better of a first- and a
 //! second-order bound. Rigorous like the reference march (it never steps over a crossing), and
-//! 2–3× cheaper in wave evaluations (`core/examples/march_levels.rs` measures it; issue #15).
+//! 2–3× cheaper (`cargo bench -p lodestone-core --bench march` times both; issue #15).
 //!
 //! Along `p(t) = o + t·d`, write `f = Σ a_i cos(φ_i + ω_i t)` with `ω_i = 2π k_i·d_xy` (and `a_i`
 //! already multiplied by the footprint attenuation for the level-of-detail surface). The waves come

@@ -103,8 +103,13 @@ fn lod_rate(d: vec3<f32>) -> f32 {
     return abs(d.z) + k * r;
 }
 
-// Evaluator::lod_march: t of the first crossing of h̄, or -1 (needs lod_prepare first).
+// Evaluator::lod_march (the octave march for a noise driver under MARCH_FAST): t of the first crossing of h̄, or -1 (needs lod_prepare first).
 fn lod_march(o: vec3<f32>, d: vec3<f32>, sf: f32) -> f32 {
+//#if noise
+    if (params.driver_kind == DRIVER_NOISE && params.march == MARCH_FAST) {
+        return octave_march(o, d, true, sf);
+    }
+//#endif
     return march_heightfield(o, d, lod_rate(d), true, sf);
 }
 //#endif

@@ -1,0 +1,210 @@
+// Mirror of `core/src/scene/octave_march.rs`, function for function under the same names.
+// `//#if feature` blocks are stripped by render/src/specialize.rs when a scene does not use the feature.
+
+//#if relief
+//#if noise
+// OctaveSurface::ray's per-ray level bounds: residual amplitude R, first-order K and curvature M per
+// level (at most MAX_LEVELS = 4).
+struct OctaveRay {
+    resid: vec4<f32>,
+    lip: vec4<f32>,
+    curv: vec4<f32>,
+}
+
+// Wave i's amplitude on the explicit surface, or times its footprint attenuation (lod_prepare) on
+// the level-of-detail surface.
+fn octave_amplitude(i: u32, lod: bool) -> f32 {
+    if (lod) {
+        return wave(i).z * lod_att[i];
+    }
+    return wave(i).z;
+}
+
+// The end of level l (noise::level_ends, packed eight bits each; the last level ends at the wave count).
+fn level_end(l: u32) -> u32 {
+    if (l + 1u >= params.level_count) {
+        return params.wave_count;
+    }
+    return (params.level_ends >> (8u * l)) & 255u;
+}
+
+// OctaveSurface::ray: the level bounds along direction d.
+fn octave_ray(d: vec3<f32>, lod: bool) -> OctaveRay {
+    var r: OctaveRay;
+    var total = 0.0;
+    for (var i = 0u; i < params.wave_count; i = i + 1u) {
+        total = total + abs(octave_amplitude(i, lod));
+    }
+    var k = 0.0;
+    var m = 0.0;
+    var below = 0.0;
+    var start = 0u;
+    for (var l = 0u; l < min(params.level_count, 4u); l = l + 1u) {
+        let e = level_end(l);
+        for (var i = start; i < e; i = i + 1u) {
+            let a = abs(octave_amplitude(i, lod));
+            let om = TAU * dot(wave(i).xy, d.xy);
+            k = k + a * abs(om);
+            m = m + a * om * om;
+            below = below + a;
+        }
+        start = e;
+        r.lip[l] = k;
+        r.curv[l] = m;
+        if (e < params.wave_count) {
+            r.resid[l] = max(total - below, 0.0);
+        }
+    }
+    return r;
+}
+
+// Wave i's (value, slope along dxy) at x, for OctaveSurface::march's partial sums.
+fn octave_term(i: u32, x: vec2<f32>, dxy: vec2<f32>, lod: bool) -> vec2<f32> {
+    let w = wave(i);
+    let a = octave_amplitude(i, lod);
+    let ph = TAU * dot(w.xy, x) + w.w;
+    return vec2<f32>(a * cos(ph), -a * TAU * dot(w.xy, dxy) * sin(ph));
+}
+
+// (f, f′ along dxy) over waves [first, end) at x. Eight waves per iteration: see UNROLL.
+fn octave_partial(first: u32, end: u32, x: vec2<f32>, dxy: vec2<f32>, lod: bool) -> vec2<f32> {
+    var acc = vec2<f32>(0.0);
+    var i = first;
+    if (end > first) {
+        let n8 = first + ((end - first) & ~7u);
+        for (; i < n8; i = i + 8u) {
+            acc = acc + octave_term(i, x, dxy, lod) + octave_term(i + 1u, x, dxy, lod)
+                + octave_term(i + 2u, x, dxy, lod) + octave_term(i + 3u, x, dxy, lod)
+                + octave_term(i + 4u, x, dxy, lod) + octave_term(i + 5u, x, dxy, lod)
+                + octave_term(i + 6u, x, dxy, lod) + octave_term(i + 7u, x, dxy, lod);
+        }
+    }
+    for (; i < end; i = i + 1u) {
+        acc = acc + octave_term(i, x, dxy, lod);
+    }
+    return acc;
+}
+
+// σ_h·g(f) on the explicit surface, σ_h·E[g(f + σ_f Z)] on the level-of-detail surface.
+fn octave_height(f: f32, lod: bool, sf: f32) -> f32 {
+    if (lod) {
+        return params.sigma_h * transfer_moments(f, sf).mean;
+    }
+    return params.sigma_h * transfer_eval(f).x;
+}
+
+// OctaveSurface::step: the longer of the first- and second-order safe steps; 1e30 stands for "the
+// gap cannot shrink" (core: infinity).
+fn octave_step(gap: f32, fd: f32, lip: f32, curv: f32, dz: f32) -> f32 {
+    let sg = params.sigma_h * params.g_lip;
+    let rate = sg * lip - dz;
+    var first = 1e30;
+    if (rate > 0.0) {
+        first = gap / rate;
+    }
+    var beta = sg * abs(fd) - dz;
+    if (params.transfer_kind == TRANSFER_IDENTITY) {
+        beta = params.sigma_h * fd - dz;
+    }
+    let c = 0.5 * sg * curv;
+    var second = 1e30;
+    if (c > 0.0) {
+        let root = sqrt(beta * beta + 4.0 * c * gap);
+        if (beta >= 0.0) {
+            second = 0.0;
+            if (beta + root > 0.0) {
+                second = 2.0 * gap / (beta + root);
+            }
+        } else {
+            second = (root - beta) / (2.0 * c);
+        }
+    } else if (beta > 0.0) {
+        second = gap / beta;
+    }
+    return max(first, second);
+}
+
+// OctaveSurface::march on the explicit (lod = false) or level-of-detail surface (lod = true, after
+// lod_prepare, whose σ_f is sf): t of the first crossing, or -1 when the ray leaves the slab.
+fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
+    let levels = clamp(params.level_count, 1u, 4u);
+    let last = levels - 1u;
+    let rw = octave_ray(d, lod);
+    let top = params.h_max * (1.0 + 1e-6) + 1e-30;
+    // The f32 guard of march_heightfield.
+    let min_step = max(params.min_step, 4.8e-7 * (max(max(abs(o.x), abs(o.y)), abs(o.z)) + top));
+    let sg = params.sigma_h * params.g_lip;
+    var t = 0.0;
+    var prev_t = 0.0;
+    var prev_g = 0.0;
+    var j = 0u;
+    for (var it = 0u; it < 20000u; it = it + 1u) {
+        let p = o + d * t;
+        if ((d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0)) {
+            return -1.0;
+        }
+        var acc = vec2<f32>(0.0);
+        var start = 0u;
+        var have = false;
+        var best_s = 0.0;
+        var best_l = 0u;
+        var best_g = 0.0;
+        var known = 0.0;
+        var deepest = 0u;
+        for (var l = 0u; l < levels; l = l + 1u) {
+            let e = level_end(l);
+            acc = acc + octave_partial(start, e, p.xy, d.xy, lod);
+            start = e;
+            deepest = l;
+            var gap = p.z - octave_height(acc.x, lod, sf) - sg * rw.resid[l];
+            if (l == last && gap < 0.0) {
+                if (t > 0.0) {
+                    return refine(o, d, prev_t, prev_g, t, gap, lod, sf);
+                }
+                // The origin is on the surface by contract: a negative gap here is rounding.
+                gap = 0.0;
+            }
+            if (gap >= 0.0) {
+                known = max(known, gap);
+                let s = octave_step(gap, acc.y, rw.lip[l], rw.curv[l], d.z);
+                if (!have || s > best_s) {
+                    have = true;
+                    best_s = s;
+                    best_l = l;
+                    best_g = gap;
+                }
+            }
+            if (l >= j && have) {
+                break;
+            }
+        }
+        if (!have) {
+            return -1.0;
+        }
+        if (best_s < min_step && deepest < last) {
+            // Too close for the coarse bounds: look again with every wave.
+            j = last;
+            continue;
+        }
+        if (best_l < j) {
+            j = best_l;
+        } else if (best_l < last && best_g < sg * (rw.resid[best_l] - rw.resid[best_l + 1u])) {
+            j = best_l + 1u;
+        }
+        prev_t = t;
+        prev_g = known;
+        if (best_s >= 1e30) {
+            // Nothing below can be met: jump out of the slab.
+            var exit = (-top - 1.0 - p.z) / d.z;
+            if (d.z > 0.0) {
+                exit = (top - p.z) / d.z;
+            }
+            t = t + max(exit, min_step) * (1.0 + 1e-6) + min_step;
+            continue;
+        }
+        t = t + max(best_s, min_step);
+    }
+    return -1.0;
+}
+//#endif
+//#endif
