@@ -117,6 +117,7 @@ const GPU_ONLY: &[(&str, &str, &str)] = &[
     ("driver/image.wgsl", "image_level", "reads a pyramid level's record from the data buffer"),
     ("material/preconvolved.wgsl", "texel4", "reads a table texel from the data buffer"),
     ("eval/shading.wgsl", "has_environment", "the parameter flag for an environment"),
+    ("scene/octave_march.wgsl", "octave_count", "the waves summed: lod_prepare's count of those the footprint leaves above 1e-10"),
     ("scene/octave_march.wgsl", "octave_amplitude", "reads wave i's amplitude, attenuated on the level-of-detail surface"),
     ("scene/surface.wgsl", "field_height", "selects the explicit or level-of-detail surface for the one march"),
     ("view.wgsl", "pcg", "per-pixel random numbers of the progressive ground truth"),

@@ -6,6 +6,7 @@
 // OctaveSurface::ray's per-ray level bounds: residual amplitude R, first-order K and curvature M per
 // level (at most MAX_LEVELS = 4).
 struct OctaveRay {
+    total: f32,
     resid: vec4<f32>,
     lip: vec4<f32>,
     curv: vec4<f32>,
@@ -20,27 +21,40 @@ fn octave_amplitude(i: u32, lod: bool) -> f32 {
     return wave(i).z;
 }
 
-// The end of level l (noise::level_ends, packed eight bits each; the last level ends at the wave count).
-fn level_end(l: u32) -> u32 {
-    if (l + 1u >= params.level_count) {
-        return params.wave_count;
+// The waves the march sums: all on the explicit surface; on the level-of-detail surface those before
+// the last one the footprint leaves above 1e-10 (lod_prepare's lod_count; the rest change no f32 sum).
+fn octave_count(lod: bool) -> u32 {
+    if (lod) {
+        return lod_count;
     }
-    return (params.level_ends >> (8u * l)) & 255u;
+    return params.wave_count;
+}
+
+// The end of level l (noise::level_ends, packed eight bits each; the last level ends at the wave
+// count), at most octave_count(lod).
+fn level_end(l: u32, lod: bool) -> u32 {
+    let n = octave_count(lod);
+    if (l + 1u >= params.level_count) {
+        return n;
+    }
+    return min((params.level_ends >> (8u * l)) & 255u, n);
 }
 
 // OctaveSurface::ray: the level bounds along direction d.
 fn octave_ray(d: vec3<f32>, lod: bool) -> OctaveRay {
     var r: OctaveRay;
+    let n = octave_count(lod);
     var total = 0.0;
-    for (var i = 0u; i < params.wave_count; i = i + 1u) {
+    for (var i = 0u; i < n; i = i + 1u) {
         total = total + abs(octave_amplitude(i, lod));
     }
+    r.total = total;
     var k = 0.0;
     var m = 0.0;
     var below = 0.0;
     var start = 0u;
     for (var l = 0u; l < min(params.level_count, 4u); l = l + 1u) {
-        let e = level_end(l);
+        let e = level_end(l, lod);
         for (var i = start; i < e; i = i + 1u) {
             let a = abs(octave_amplitude(i, lod));
             let om = TAU * dot(wave(i).xy, d.xy);
@@ -51,7 +65,7 @@ fn octave_ray(d: vec3<f32>, lod: bool) -> OctaveRay {
         start = e;
         r.lip[l] = k;
         r.curv[l] = m;
-        if (e < params.wave_count) {
+        if (e < n) {
             r.resid[l] = max(total - below, 0.0);
         }
     }
@@ -130,10 +144,11 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
     let levels = clamp(params.level_count, 1u, 4u);
     let last = levels - 1u;
     let rw = octave_ray(d, lod);
-    let top = params.h_max * (1.0 + 1e-6) + 1e-30;
+    let sg = params.sigma_h * params.g_lip;
+    // The slab: |h| ≤ h_max and |G(f)| ≤ |G(0)| + g_lip Σ|a_i| (thin in the far field).
+    let top = min(params.h_max, abs(octave_height(0.0, lod, sf)) + sg * rw.total) * (1.0 + 1e-6) + 1e-30;
     // The f32 guard of march_heightfield.
     let min_step = max(params.min_step, 4.8e-7 * (max(max(abs(o.x), abs(o.y)), abs(o.z)) + top));
-    let sg = params.sigma_h * params.g_lip;
     var t = 0.0;
     var prev_t = 0.0;
     var prev_g = 0.0;
@@ -152,7 +167,7 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
         var known = 0.0;
         var deepest = 0u;
         for (var l = 0u; l < levels; l = l + 1u) {
-            let e = level_end(l);
+            let e = level_end(l, lod);
             acc = acc + octave_partial(start, e, p.xy, d.xy, lod);
             start = e;
             deepest = l;
