@@ -10,6 +10,7 @@ use lodestone_core::microfacet::effective_height::{
 };
 use lodestone_core::microfacet::masking_shadowing::AZIMUTH_CORRELATION;
 use lodestone_core::scene::march::RELAXATION;
+use lodestone_core::scene::octave_march::HIT_GAP_F32;
 use std::fmt::Write;
 use std::sync::LazyLock;
 
@@ -160,6 +161,7 @@ pub fn wgsl_prelude() -> &'static str {
             ("DH_FIT_BETA_SIGMA", FIT_BETA_SIGMA),
             ("AZIMUTH_CORRELATION", AZIMUTH_CORRELATION),
             ("RELAXATION", RELAXATION),
+            ("HIT_GAP", HIT_GAP_F32),
         ];
         for (name, v) in floats {
             let _ = writeln!(s, "const {name}: f32 = {:?};", v as f32);

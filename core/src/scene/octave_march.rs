@@ -21,6 +21,11 @@
 //! level-of-detail surface far away, where the footprint has attenuated every wave, it is thin, so
 //! the far field costs a step or two by construction.
 //!
+//! A ray that starts clear of the surface (gap > 1000 ε at t = 0: a camera ray) stops as soon as the
+//! exact gap is within `ε = HIT_GAP·top` of it, on the surface to within shading precision, instead of
+//! stepping across and refining the bracket (a third of the work at 30–60°). A ray that leaves the
+//! surface (a shadow ray) must cross it to be stopped, so it never shadows itself.
+//!
 //! Either bound stays positive up to its first root, so the step is the larger of the two roots,
 //! over every level evaluated at the point (a coarse level sees far, the last one sees close). The
 //! march evaluates the levels coarse to fine (each prefix sum extends the previous one, so the
@@ -34,6 +39,13 @@ use crate::driver::noise::{MAX_LEVELS, Wave};
 use crate::scene::march::{March, refine};
 use glam::{DVec2, DVec3};
 use std::f64::consts::TAU;
+
+/// A march that started clear of the surface stops where the exact gap is at most this fraction of
+/// the slab's half thickness (module docs). The WGSL, in f32, uses [`HIT_GAP_F32`].
+pub const HIT_GAP: f64 = 1e-12;
+
+/// [`HIT_GAP`] for the f32 WGSL: a few f32 ulps of the slab, where the gap itself is rounding.
+pub const HIT_GAP_F32: f64 = 4e-6;
 
 /// A noise-driven heightfield `σ_h·G(f)` as the fast march sees it.
 #[derive(Clone, Copy, Debug)]
@@ -150,6 +162,10 @@ impl OctaveSurface<'_> {
         };
         let (mut t, mut prev_t, mut prev_g) = (0.0f64, 0.0f64, 0.0f64);
         let mut j = 0usize;
+        // A ray that starts clear of the surface (a camera ray from the slab's top) may settle on it
+        // (module docs); one leaving the surface (a shadow ray) must cross it to be stopped.
+        let settle = HIT_GAP * top;
+        let mut may_settle = None;
         for _ in 0..1_000_000 {
             let z = o.z + d.z * t;
             if (d.z >= 0.0 && z > top) || (d.z < 0.0 && z < -top - 1.0) {
@@ -173,6 +189,10 @@ impl OctaveSurface<'_> {
                 start = e;
                 deepest = l;
                 let mut gap = z - height_of(f) - sg * rw.resid[l];
+                if l == last && t > 0.0 && (0.0..=settle).contains(&gap) && may_settle == Some(true)
+                {
+                    return Some(t);
+                }
                 if l == last && gap < 0.0 {
                     if t > 0.0 {
                         return Some(refine(&exact_gap, (prev_t, prev_g), (t, gap), march));
@@ -206,6 +226,9 @@ impl OctaveSurface<'_> {
             }
             prev_t = t;
             prev_g = known;
+            if may_settle.is_none() {
+                may_settle = Some(known > 1e3 * settle);
+            }
             if !step.is_finite() {
                 // Nothing below can be met: jump out of the slab.
                 let exit = if d.z > 0.0 {

@@ -153,6 +153,9 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
     var prev_t = 0.0;
     var prev_g = 0.0;
     var j = 0u;
+    // A camera ray may settle on the surface; a shadow ray must cross it (core's module docs).
+    let settle = HIT_GAP * top;
+    var may_settle = 0u;
     for (var it = 0u; it < 20000u; it = it + 1u) {
         let p = o + d * t;
         if ((d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0)) {
@@ -172,6 +175,9 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
             start = e;
             deepest = l;
             var gap = p.z - octave_height(acc.x, lod, sf) - sg * rw.resid[l];
+            if (l == last && t > 0.0 && gap >= 0.0 && gap <= settle && may_settle == 1u) {
+                return t;
+            }
             if (l == last && gap < 0.0) {
                 if (t > 0.0) {
                     return refine(o, d, prev_t, prev_g, t, gap, lod, sf);
@@ -208,6 +214,9 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
         }
         prev_t = t;
         prev_g = known;
+        if (may_settle == 0u) {
+            may_settle = select(2u, 1u, known > 1e3 * settle);
+        }
         if (best_s >= 1e30) {
             // Nothing below can be met: jump out of the slab.
             var exit = (-top - 1.0 - p.z) / d.z;
