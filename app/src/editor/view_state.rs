@@ -98,7 +98,7 @@ impl Default for ViewState {
     fn default() -> Self {
         Self {
             camera: Camera {
-                elevation_deg: 70.0,
+                elevation_deg: 77.0,
                 azimuth_deg: 0.0,
                 distance: 3.0,
                 target: [0.0, 0.0],
