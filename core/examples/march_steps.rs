@@ -1,7 +1,8 @@
 //! How many height evaluations the ground-truth march spends per ray, with the reference step
 //! (global Lipschitz bound, `march_heightfield`) against a local second-order step (the exact slope
 //! of the gap at the current point plus a bound on its curvature), and whether both find the same
-//! first crossing. A measurement for issue #15, not used by the renderer:
+//! first crossing. The measurement behind the octave march of issue #15 (`scene/octave_march.rs`,
+//! which adds nested octave levels to this step and is what renders):
 //! `cargo run --release -p lodestone-core --example march_steps [PRESET.ron]`.
 //!
 //! The second-order step: along `p(t) = o + t·d` with `u = d_xy`, the gap `γ(t) = z(t) − σ_h f(x(t))`
