@@ -30,7 +30,7 @@ pub struct Surface {
     pub min_step: f64,
     /// How marches on this surface (and on its level-of-detail surface) step and refine a crossing.
     pub march: March,
-    /// The nested octave levels of a noise driver's fast march ([`SumOfSines::level_ends`]; empty
+    /// The nested octave levels of a noise driver's fast march ([`crate::driver::noise::SumOfSines::level_ends`]; empty
     /// for an image).
     pub levels: Vec<usize>,
 }
