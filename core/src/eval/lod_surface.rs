@@ -5,7 +5,7 @@
 use crate::driver::field::DriverField;
 use crate::driver::footprint::Footprint;
 use crate::eval::Evaluator;
-use crate::scene::march::march_heightfield;
+use crate::scene::march::{March, march_heightfield};
 use glam::{DVec2, DVec3};
 
 impl Evaluator {
@@ -30,20 +30,15 @@ impl Evaluator {
         d.z.abs() + k * r
     }
 
-    /// March `o + t·d` against h̄ (the same [`march_heightfield`] as the explicit surface).
+    /// March `o + t·d` against h̄ with the explicit surface's march: the octave march for a noise
+    /// driver under [`March::Fast`], else [`march_heightfield`] with the level-of-detail rate.
     pub fn lod_march(&self, o: DVec3, d: DVec3, fp: Footprint) -> Option<f64> {
         let s = &self.surface;
-        if let DriverField::Noise(n) = &s.driver {
+        if let (DriverField::Noise(n), March::Fast) = (&s.driver, s.march) {
             let att: Vec<f64> = n.waves.iter().map(|w| n.attenuation(w, fp)).collect();
             if let Some(os) = s.octaves(Some(&att)) {
-                // σ_f is the phase average, the same everywhere (DriverField::lod_moments).
-                let var: f64 = n
-                    .waves
-                    .iter()
-                    .zip(&att)
-                    .map(|(w, g)| w.amplitude * w.amplitude * (1.0 - g * g) / 2.0)
-                    .sum();
-                let sf = var.max(0.0).sqrt();
+                // σ_f is the phase average, the same at every x.
+                let sf = s.driver.lod_moments(DVec2::new(o.x, o.y), fp).1;
                 let height_of = |m| s.sigma_h * self.transfer.moments(m, sf).mean;
                 return os.march(o, d, height_of, s.march);
             }
