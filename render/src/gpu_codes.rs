@@ -9,6 +9,7 @@ use lodestone_core::microfacet::effective_height::{
     FIT_ALPHA_MU, FIT_ALPHA_SIGMA, FIT_BETA_MU, FIT_BETA_SIGMA,
 };
 use lodestone_core::microfacet::masking_shadowing::AZIMUTH_CORRELATION;
+use lodestone_core::scene::march::FAST_WIDTH_F32;
 use lodestone_core::scene::march::RELAXATION;
 use lodestone_core::scene::octave_march::HIT_GAP_F32;
 use std::fmt::Write;
@@ -162,6 +163,7 @@ pub fn wgsl_prelude() -> &'static str {
             ("AZIMUTH_CORRELATION", AZIMUTH_CORRELATION),
             ("RELAXATION", RELAXATION),
             ("HIT_GAP", HIT_GAP_F32),
+            ("FAST_WIDTH", FAST_WIDTH_F32),
         ];
         for (name, v) in floats {
             let _ = writeln!(s, "const {name}: f32 = {:?};", v as f32);

@@ -5,7 +5,9 @@
 use crate::driver::field::DriverField;
 use crate::driver::footprint::Footprint;
 use crate::eval::Evaluator;
+use crate::eval::compiled::CompiledTransfer;
 use crate::scene::march::{March, march_heightfield};
+use crate::scene::octave_march::LocalSlope;
 use glam::{DVec2, DVec3};
 
 impl Evaluator {
@@ -36,9 +38,14 @@ impl Evaluator {
         let s = &self.surface;
         if let (DriverField::Noise(n), March::Fast) = (&s.driver, s.march) {
             let att: Vec<f64> = n.waves.iter().map(|w| n.attenuation(w, fp)).collect();
-            if let Some(os) = s.octaves(Some(&att)) {
+            if let Some(mut os) = s.octaves(Some(&att)) {
                 // σ_f is the phase average, the same at every x.
                 let sf = s.driver.lod_moments(DVec2::new(o.x, o.y), fp).1;
+                if let (Some(poly), CompiledTransfer::Curve { table }) =
+                    (&s.transfer_poly, &self.transfer)
+                {
+                    os.g_slope = Some(LocalSlope::level_of_detail(poly, table, sf, s.g_lip));
+                }
                 let height_of = |m| s.sigma_h * self.transfer.moments(m, sf).mean;
                 return os.march(o, d, height_of, s.march);
             }

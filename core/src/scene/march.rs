@@ -119,6 +119,14 @@ pub fn sphere_trace(
 /// crossing. [`March::Reference`] bisects 48 times; [`March::Fast`] runs the Illinois method
 /// (regula falsi whose end that stays put twice has its gap halved), which keeps the bracket, falls
 /// back to the midpoint when the secant leaves it, and stops at the same width.
+/// [`March::Fast`]'s refinement stops at this fraction of max(|t|, 1), about 4500 f64 ulps of t:
+/// below it the gap itself is rounding (a sum of unit-scale terms), so further halvings only
+/// shuffle which side rounding puts a point on. Far below any shading precision.
+pub const FAST_WIDTH: f64 = 1.0 / (1u64 << 40) as f64;
+
+/// [`FAST_WIDTH`] for the f32 WGSL: 8 f32 ulps of max(|t|, 1).
+pub const FAST_WIDTH_F32: f64 = 1.0 / (1u64 << 20) as f64;
+
 pub fn refine(
     gap: &impl Fn(f64) -> f64,
     (mut a, mut ga): (f64, f64),
@@ -139,7 +147,7 @@ pub fn refine(
             a
         }
         March::Fast => {
-            let width = ((b - a) * 0.5f64.powi(HALVINGS)).max(f64::EPSILON * b.abs());
+            let width = ((b - a) * 0.5f64.powi(HALVINGS)).max(FAST_WIDTH * b.abs().max(1.0));
             let mut side = 0;
             for _ in 0..2 * HALVINGS {
                 if b - a <= width {
@@ -149,6 +157,9 @@ pub fn refine(
                 if !(c > a && c < b) {
                     c = 0.5 * (a + b);
                 }
+                // Half a width inside the bracket: once the secant is that close to the crossing,
+                // the next point lands across it and closes the bracket.
+                c = c.clamp(a + 0.5 * width, b - 0.5 * width);
                 let gc = gap(c);
                 if gc >= 0.0 {
                     (a, ga) = (c, gc);

@@ -36,6 +36,8 @@
 //! [`crate::scene::march::march_heightfield`].
 
 use crate::driver::noise::{MAX_LEVELS, Wave};
+use crate::material::preconvolved::PreconvolvedTable;
+use crate::math::piecewise::PiecewisePoly;
 use crate::scene::march::{March, refine};
 use glam::{DVec2, DVec3};
 use std::f64::consts::TAU;
@@ -67,6 +69,57 @@ pub struct OctaveSurface<'a> {
     pub h_max: f64,
     /// Minimum step.
     pub min_step: f64,
+    /// Local Lipschitz constants of G for a transfer curve (`None` for the identity): the march
+    /// then steps with max|G′| over the range f can reach in the step instead of `g_lip`.
+    pub g_slope: Option<LocalSlope<'a>>,
+}
+
+/// A bound of |G′| over an interval of f, for the octave march's local steps: the largest |g′| over
+/// the interval widened by `widen` (exact for the curve's piecewise quadratic g′,
+/// [`PiecewisePoly::max_abs_on`]), plus `tail`, never more than the global `g_lip`.
+///
+/// On the explicit surface G = g (`widen = tail = 0`). On the level-of-detail surface G(m) is the
+/// table of `E[g(m + σ_f Z)]`, interpolated between nodes; its slope between nodes is
+/// `E[g′(m′ + σ′Z)]` at some node-interval point m′ and row σ′ ≤ σ_f + Δσ, at most the largest |g′|
+/// within 6(σ_f + Δσ) of the interval widened by one column Δm, plus `g_lip·P(|Z| > 6) < 2e-9·g_lip`.
+#[derive(Clone, Copy, Debug)]
+pub struct LocalSlope<'a> {
+    /// The curve's [`crate::material::transfer::Curve::moment_poly`] (channel 2 is g′).
+    pub poly: &'a PiecewisePoly,
+    /// How far the interval is widened on either side.
+    pub widen: f64,
+    /// Added to the bound.
+    pub tail: f64,
+}
+
+impl<'a> LocalSlope<'a> {
+    /// The channel of g′ in [`crate::material::transfer::Curve::moment_poly`].
+    pub const DERIVATIVE_CHANNEL: usize = 2;
+
+    /// The bound for the level-of-detail surface, whose G is `table` (the curve's pre-convolved
+    /// moments) at σ_f = `sf`: widened by `6(σ_f + Δσ) + Δm` with `tail = 2e-9·g_lip` (struct docs).
+    pub fn level_of_detail(
+        poly: &'a PiecewisePoly,
+        table: &PreconvolvedTable,
+        sf: f64,
+        g_lip: f64,
+    ) -> Self {
+        let dm = (table.m_max - table.m_min) / (table.size_m.max(2) - 1) as f64;
+        let ds = table.sigma_max / (table.size_sigma.max(2) - 1) as f64;
+        Self {
+            poly,
+            widen: 6.0 * (sf.max(0.0) + ds) + dm.abs(),
+            tail: 2e-9 * g_lip,
+        }
+    }
+
+    /// A bound of |G′| on [lo, hi] (before the cap at the global `g_lip`).
+    pub fn lipschitz_on(&self, lo: f64, hi: f64) -> f64 {
+        self.poly
+            .max_abs_on(Self::DERIVATIVE_CHANNEL, lo - self.widen, hi + self.widen)
+            * (1.0 + 1e-9)
+            + self.tail
+    }
 }
 
 /// Per-ray constants of the waves: amplitudes, frequencies along the ray and the level bounds.
@@ -188,7 +241,8 @@ impl OctaveSurface<'_> {
                 fd += dfd;
                 start = e;
                 deepest = l;
-                let mut gap = z - height_of(f) - sg * rw.resid[l];
+                let hf = height_of(f);
+                let mut gap = z - hf - sg * rw.resid[l];
                 if l == last && t > 0.0 && (0.0..=settle).contains(&gap) && may_settle == Some(true)
                 {
                     return Some(t);
@@ -199,9 +253,10 @@ impl OctaveSurface<'_> {
                     }
                     gap = 0.0;
                 }
-                if gap >= 0.0 {
+                let found =
+                    (gap >= 0.0).then(|| (self.step(gap, fd, rw.lip[l], rw.curv[l], d.z, sg), gap));
+                if let Some((s, gap)) = self.local_step(found, z - hf, f, fd, l, &rw, d.z) {
                     known = known.max(gap);
-                    let s = self.step(gap, fd, rw.lip[l], rw.curv[l], d.z);
                     if best.is_none_or(|b| s > b.0) {
                         best = Some((s, l, gap));
                     }
@@ -247,8 +302,7 @@ impl OctaveSurface<'_> {
     /// The longer of the first- and second-order safe steps (module docs) from gap `gap ≥ 0` with
     /// the level's slope `fd`, Lipschitz `lip` and curvature `curv`. Infinite when the gap cannot
     /// shrink.
-    fn step(&self, gap: f64, fd: f64, lip: f64, curv: f64, dz: f64) -> f64 {
-        let sg = self.sigma_h * self.g_lip;
+    fn step(&self, gap: f64, fd: f64, lip: f64, curv: f64, dz: f64, sg: f64) -> f64 {
         let rate = sg * lip - dz;
         let first = if rate > 0.0 {
             gap / rate
@@ -278,6 +332,54 @@ impl OctaveSurface<'_> {
             f64::INFINITY
         };
         first.max(second)
+    }
+
+    /// Improve the level's `(step, gap)` found with the global `g_lip` (`None` when that gap is
+    /// negative) by the local Lipschitz constant of G ([`LocalSlope`]): for a trial length s, f stays
+    /// within `f_l ± (R_l + K_l s)` along it, so the level's gap and step bounds hold there with G′
+    /// bounded on that interval, and a step no longer than its trial is safe. Trials grow 8× from
+    /// 8·max(step, min_step) while they succeed (at most four). `above` is `z − σ_h·G(f_l)`; the
+    /// gap returned is a lower bound of the true gap at the point.
+    #[allow(clippy::too_many_arguments)]
+    fn local_step(
+        &self,
+        found: Option<(f64, f64)>,
+        above: f64,
+        f: f64,
+        fd: f64,
+        l: usize,
+        rw: &RayWaves,
+        dz: f64,
+    ) -> Option<(f64, f64)> {
+        let Some(gs) = self.g_slope else {
+            return found;
+        };
+        if found.is_some_and(|(s, _)| !s.is_finite()) {
+            return found;
+        }
+        let (resid, lip) = (rw.resid[l], rw.lip[l]);
+        let mut best = found;
+        let mut trial = 8.0 * found.map_or(0.0, |b| b.0).max(self.min_step);
+        for _ in 0..4 {
+            let reach = resid + lip * trial;
+            let g = gs.lipschitz_on(f - reach, f + reach).min(self.g_lip);
+            let sg = self.sigma_h * g;
+            let gap = above - sg * resid;
+            if !(gap >= 0.0) {
+                break;
+            }
+            let s = self.step(gap, fd, lip, rw.curv[l], dz, sg);
+            let step = s.min(trial);
+            best = match best {
+                Some((b, g0)) => Some((b.max(step), g0.max(gap))),
+                None => Some((step, gap)),
+            };
+            if s < trial {
+                break;
+            }
+            trial *= 8.0;
+        }
+        best
     }
 }
 

@@ -9,8 +9,9 @@
 use crate::driver::field::DriverField;
 use crate::material::Material;
 use crate::material::transfer::TransferFunction;
+use crate::math::piecewise::PiecewisePoly;
 use crate::scene::march::{March, march_heightfield};
-use crate::scene::octave_march::OctaveSurface;
+use crate::scene::octave_march::{LocalSlope, OctaveSurface};
 use glam::{DVec2, DVec3};
 
 /// The explicit heightfield of a material.
@@ -33,6 +34,9 @@ pub struct Surface {
     /// The nested octave levels of a noise driver's fast march ([`crate::driver::noise::SumOfSines::level_ends`]; empty
     /// for an image).
     pub levels: Vec<usize>,
+    /// A transfer curve's [`crate::material::transfer::Curve::moment_poly`], built once (`None` for the identity): g and the
+    /// fast march's local Lipschitz constants of g ([`LocalSlope`]).
+    pub transfer_poly: Option<PiecewisePoly>,
 }
 
 /// Result of marching a ray.
@@ -68,8 +72,13 @@ impl Surface {
             DriverField::Noise(n) => n.level_ends(),
             DriverField::Image(_) => Vec::new(),
         };
+        let transfer_poly = match &transfer {
+            TransferFunction::Identity => None,
+            TransferFunction::Curve(c) => Some(c.moment_poly()),
+        };
         Self {
             levels,
+            transfer_poly,
             g_lip: transfer.max_derivative(),
             driver,
             sigma_h,
@@ -82,7 +91,20 @@ impl Surface {
 
     /// h(x).
     pub fn height(&self, x: DVec2) -> f64 {
-        self.sigma_h * self.transfer.eval(self.driver.value(x))
+        self.height_of(self.driver.value(x))
+    }
+
+    /// σ_h·g(f) (the same values as [`TransferFunction::eval`], from the poly built once).
+    pub fn height_of(&self, f: f64) -> f64 {
+        let g = match &self.transfer_poly {
+            Some(p) => {
+                let mut o = [0.0; 4];
+                p.eval(f, &mut o);
+                o[0]
+            }
+            None => self.transfer.eval(f),
+        };
+        self.sigma_h * g
     }
 
     /// f(x), h(x) and ∇h(x) = σ_h g′(f) ∇f.
@@ -110,8 +132,7 @@ impl Surface {
     /// (a shadow ray leaving a hit point), never as a crossing.
     pub fn march(&self, o: DVec3, d: DVec3) -> Trace {
         if let Some(os) = self.octaves(None) {
-            let height_of = |f| self.sigma_h * self.transfer.eval(f);
-            return match os.march(o, d, height_of, self.march) {
+            return match os.march(o, d, |f| self.height_of(f), self.march) {
                 Some(t) => Trace::Hit(t),
                 None => Trace::Escape,
             };
@@ -146,6 +167,11 @@ impl Surface {
             linear: matches!(self.transfer, TransferFunction::Identity),
             h_max: self.h_max,
             min_step: self.min_step,
+            g_slope: self.transfer_poly.as_ref().map(|poly| LocalSlope {
+                poly,
+                widen: 0.0,
+                tail: 0.0,
+            }),
         })
     }
 

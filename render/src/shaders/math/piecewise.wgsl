@@ -25,4 +25,42 @@ fn poly_eval(off: u32, k: u32, channels: u32, ch: u32, x: f32) -> f32 {
     let c = coeff + 4u * (seg * channels + ch);
     return ((data[c + 3u] * t + data[c + 2u]) * t + data[c + 1u]) * t + data[c];
 }
+
+// PiecewisePoly::max_abs_on: the largest |p_ch| over [lo, hi] for a channel of degree ≤ 2 (interval
+// ends, each crossed segment's vertex, the tails); 0 for an empty or NaN interval.
+fn poly_max_abs_on(off: u32, k: u32, channels: u32, ch: u32, lo: f32, hi: f32) -> f32 {
+    if (!(lo <= hi)) {
+        return 0.0;
+    }
+    let coeff = off + k;
+    let tails = coeff + 4u * channels * (k - 1u);
+    var best = 0.0;
+    if (lo < data[off]) {
+        best = abs(data[tails + ch]);
+    }
+    if (hi >= data[off + k - 1u]) {
+        best = max(best, abs(data[tails + channels + ch]));
+    }
+    for (var seg = 0u; seg + 1u < k; seg = seg + 1u) {
+        let a = data[off + seg];
+        let b = data[off + seg + 1u];
+        if (!(b > a) || hi < a || lo > b) {
+            continue;
+        }
+        let c = coeff + 4u * (seg * channels + ch);
+        let c0 = data[c];
+        let c1 = data[c + 1u];
+        let c2 = data[c + 2u];
+        let t0 = clamp((lo - a) / (b - a), 0.0, 1.0);
+        let t1 = clamp((hi - a) / (b - a), 0.0, 1.0);
+        best = max(best, max(abs((c2 * t0 + c1) * t0 + c0), abs((c2 * t1 + c1) * t1 + c0)));
+        if (c2 != 0.0) {
+            let tv = -c1 / (2.0 * c2);
+            if (tv > t0 && tv < t1) {
+                best = max(best, abs((c2 * tv + c1) * tv + c0));
+            }
+        }
+    }
+    return best;
+}
 //#endif

@@ -75,7 +75,7 @@ fn refine(o: vec3<f32>, d: vec3<f32>, a_in: f32, ga_in: f32, b_in: f32, gb_in: f
     }
     var ga = ga_in;
     var gb = gb_in;
-    let width = max((b - a) * 5.9604645e-8, 1.1920929e-7 * abs(b));
+    let width = max((b - a) * 5.9604645e-8, FAST_WIDTH * max(abs(b), 1.0));
     var side = 0;
     for (var j = 0u; j < 48u; j = j + 1u) {
         if (b - a <= width) {
@@ -85,6 +85,8 @@ fn refine(o: vec3<f32>, d: vec3<f32>, a_in: f32, ga_in: f32, b_in: f32, gb_in: f
         if (!(c > a && c < b)) {
             c = 0.5 * (a + b);
         }
+        // Half a width inside the bracket, so a converged secant closes it (core's refine).
+        c = clamp(c, a + 0.5 * width, b - 0.5 * width);
         let gc = gap_at(o, d, c, lod, sf);
         if (gc >= 0.0) {
             a = c;

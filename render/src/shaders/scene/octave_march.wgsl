@@ -109,8 +109,7 @@ fn octave_height(f: f32, lod: bool, sf: f32) -> f32 {
 
 // OctaveSurface::step: the longer of the first- and second-order safe steps; 1e30 stands for "the
 // gap cannot shrink" (core: infinity).
-fn octave_step(gap: f32, fd: f32, lip: f32, curv: f32, dz: f32) -> f32 {
-    let sg = params.sigma_h * params.g_lip;
+fn octave_step(gap: f32, fd: f32, lip: f32, curv: f32, dz: f32, sg: f32) -> f32 {
     let rate = sg * lip - dz;
     var first = 1e30;
     if (rate > 0.0) {
@@ -136,6 +135,58 @@ fn octave_step(gap: f32, fd: f32, lip: f32, curv: f32, dz: f32) -> f32 {
         second = gap / beta;
     }
     return max(first, second);
+}
+
+// LocalSlope::lipschitz_on (with LocalSlope::level_of_detail's widening when lod): a bound of |G′|
+// over [lo, hi] for a transfer curve, at most g_lip; g_lip for the identity.
+fn octave_lipschitz_on(lo: f32, hi: f32, lod: bool, sf: f32) -> f32 {
+//#if transfer_curve
+    if (params.transfer_kind != TRANSFER_IDENTITY) {
+        var widen = 0.0;
+        var tail = 0.0;
+        if (lod) {
+            let dm = (params.tt_m_max - params.tt_m_min) / f32(max(params.tt_size_m, 2u) - 1u);
+            let ds = params.tt_sigma_max / f32(max(params.tt_size_s, 2u) - 1u);
+            widen = 6.0 * (sf + ds) + dm;
+            tail = 2e-9 * params.g_lip;
+        }
+        let g = poly_max_abs_on(params.tp_offset, params.tp_knots, 2u, 1u, lo - widen, hi + widen);
+        return min(g * (1.0 + 1e-5) + tail, params.g_lip);
+    }
+//#endif
+    return params.g_lip;
+}
+
+// OctaveSurface::local_step: lengthen the level's (step, gap, found) by the local Lipschitz constant
+// of G over the range f can reach in trial steps growing 8× (at most four); above = z − σ_h·G(f_l).
+fn octave_local_step(found_in: vec3<f32>, above: f32, f: f32, fd: f32, lip: f32, curv: f32, resid: f32, dz: f32, lod: bool, sf: f32, min_step: f32) -> vec3<f32> {
+    var found = found_in;
+//#if transfer_curve
+    if (params.transfer_kind == TRANSFER_IDENTITY || (found.z > 0.0 && found.x >= 1e30)) {
+        return found;
+    }
+    var trial = 8.0 * max(select(0.0, found.x, found.z > 0.0), min_step);
+    for (var i = 0u; i < 4u; i = i + 1u) {
+        let reach = resid + lip * trial;
+        let sg = params.sigma_h * octave_lipschitz_on(f - reach, f + reach, lod, sf);
+        let gap = above - sg * resid;
+        if (!(gap >= 0.0)) {
+            break;
+        }
+        let s = octave_step(gap, fd, lip, curv, dz, sg);
+        let step = min(s, trial);
+        if (found.z > 0.0) {
+            found = vec3<f32>(max(found.x, step), max(found.y, gap), 1.0);
+        } else {
+            found = vec3<f32>(step, gap, 1.0);
+        }
+        if (s < trial) {
+            break;
+        }
+        trial = trial * 8.0;
+    }
+//#endif
+    return found;
 }
 
 // OctaveSurface::march on the explicit (lod = false) or level-of-detail surface (lod = true, after
@@ -174,7 +225,8 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
             acc = acc + octave_partial(start, e, p.xy, d.xy, lod);
             start = e;
             deepest = l;
-            var gap = p.z - octave_height(acc.x, lod, sf) - sg * rw.resid[l];
+            let above = p.z - octave_height(acc.x, lod, sf);
+            var gap = above - sg * rw.resid[l];
             if (l == last && t > 0.0 && gap >= 0.0 && gap <= settle && may_settle == 1u) {
                 return t;
             }
@@ -185,14 +237,18 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
                 // The origin is on the surface by contract: a negative gap here is rounding.
                 gap = 0.0;
             }
+            var found = vec3<f32>(0.0);
             if (gap >= 0.0) {
-                known = max(known, gap);
-                let s = octave_step(gap, acc.y, rw.lip[l], rw.curv[l], d.z);
-                if (!have || s > best_s) {
+                found = vec3<f32>(octave_step(gap, acc.y, rw.lip[l], rw.curv[l], d.z, sg), gap, 1.0);
+            }
+            found = octave_local_step(found, above, acc.x, acc.y, rw.lip[l], rw.curv[l], rw.resid[l], d.z, lod, sf, min_step);
+            if (found.z > 0.0) {
+                known = max(known, found.y);
+                if (!have || found.x > best_s) {
                     have = true;
-                    best_s = s;
+                    best_s = found.x;
                     best_l = l;
-                    best_g = gap;
+                    best_g = found.y;
                 }
             }
             if (l >= j && have) {
