@@ -9,9 +9,10 @@ use lodestone_core::microfacet::effective_height::{
     FIT_ALPHA_MU, FIT_ALPHA_SIGMA, FIT_BETA_MU, FIT_BETA_SIGMA,
 };
 use lodestone_core::microfacet::masking_shadowing::AZIMUTH_CORRELATION;
+use lodestone_core::scene::bound_grid::GRID_MARGIN_F32;
 use lodestone_core::scene::march::FAST_WIDTH_F32;
 use lodestone_core::scene::march::RELAXATION;
-use lodestone_core::scene::octave_march::HIT_GAP_F32;
+use lodestone_core::scene::octave_march::{GRID_TRIES, HIT_GAP_F32};
 use std::fmt::Write;
 use std::sync::LazyLock;
 
@@ -152,7 +153,8 @@ pub fn wgsl_prelude() -> &'static str {
             HeightFilterCode::WGSL,
             MarchCode::WGSL,
         ];
-        for (name, v) in sets.into_iter().flatten() {
+        let counts: &[(&str, u32)] = &[("GRID_TRIES", GRID_TRIES as u32)];
+        for (name, v) in sets.into_iter().flatten().chain(counts) {
             let _ = writeln!(s, "const {name}: u32 = {v}u;");
         }
         let floats = [
@@ -164,6 +166,7 @@ pub fn wgsl_prelude() -> &'static str {
             ("RELAXATION", RELAXATION),
             ("HIT_GAP", HIT_GAP_F32),
             ("FAST_WIDTH", FAST_WIDTH_F32),
+            ("GRID_MARGIN", GRID_MARGIN_F32),
         ];
         for (name, v) in floats {
             let _ = writeln!(s, "const {name}: f32 = {:?};", v as f32);

@@ -224,8 +224,27 @@ gpu_struct! {
         level_count: u32 => "u32",
         /// The first three levels' ends, eight bits each (the last level ends at `wave_count`).
         level_ends: u32 => "u32",
+        /// Offset of the bound grid's pyramid (`[lo, hi]` per cell, level after level).
+        grid_offset: u32 => "u32",
+        /// Level-0 cells per side of the bound grid (0: no grid).
+        grid_n: u32 => "u32",
+        /// Levels of the bound grid's pyramid.
+        grid_levels: u32 => "u32",
+        /// Side of a level-0 cell of the bound grid.
+        grid_cell: f32 => "f32",
+        /// The bound grid's lower-left corner relative to the camera target, x.
+        grid_x0: f32 => "f32",
+        /// The bound grid's lower-left corner relative to the camera target, y.
+        grid_y0: f32 => "f32",
+        /// Σ|a_i| of the waves (the grid's tails and f32 margin are relative to it).
+        grid_amp: f32 => "f32",
+        /// Monotonicity of the transfer function: 1 never decreasing (the identity too), 2 never
+        /// increasing, 0 neither (core's `OctaveSurface::monotone`).
+        transfer_monotone: u32 => "u32",
         /// Padding to WGSL's 16-byte struct size.
-        pad: [u32; 2] => "vec2<u32>",
+        pad1: u32 => "u32",
+        /// Padding.
+        pad2: u32 => "u32",
     }
 }
 
@@ -241,8 +260,7 @@ mod tests {
         assert_eq!(
             w.matches(": u32,").count()
                 + w.matches(": f32,").count()
-                + w.matches(": vec3<f32>,").count()
-                + w.matches(": vec2<u32>,").count(),
+                + w.matches(": vec3<f32>,").count(),
             MaterialParams::FIELDS.len()
         );
         assert!(w.contains("    sigma_h: f32,"));

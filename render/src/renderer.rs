@@ -8,7 +8,7 @@ use crate::gpu_codes::{
 };
 use crate::gpu_types::{MaterialParams, ViewParams};
 use crate::specialize::{SpecializeError, view_source_for};
-use glam::DVec3;
+use glam::{DVec2, DVec3};
 use lodestone_core::driver::field::{DriverField, TiledImage};
 use lodestone_core::eval::Evaluator;
 use lodestone_core::material::color_terms::CombineMode;
@@ -21,6 +21,7 @@ use lodestone_core::math::piecewise::PiecewisePoly;
 use lodestone_core::microfacet::effective_height::{EffectiveHeightTable, HeightFilter};
 use lodestone_core::microfacet::masking_shadowing::Correlation;
 use lodestone_core::microfacet::visible_slopes::slope_rule;
+use lodestone_core::scene::bound_grid::BoundGrid;
 use lodestone_core::scene::camera::{Camera, PIXEL_SIGMA};
 use lodestone_core::scene::march::March;
 use lodestone_core::scene::shape::Shape;
@@ -571,6 +572,14 @@ pub fn material_data_for(
         March::Fast => MarchCode::Fast,
     }
     .code();
+    base.transfer_monotone = match &m.heights.transfer {
+        TransferFunction::Identity => 1,
+        TransferFunction::Curve(c) => match c.monotone() {
+            Some(true) => 1,
+            Some(false) => 2,
+            None => 0,
+        },
+    };
     base.g_mean = prepared.global_height.0 as f32;
     base.g_std = prepared.global_height.1 as f32;
     MaterialData {
@@ -578,6 +587,47 @@ pub fn material_data_for(
         params: base,
         segments,
     }
+}
+
+/// Cells per side of the bound grid the GPU march reads (core's [`BoundGrid::around`]): 512² cells,
+/// a pyramid of 2.8 MB, built in tens of milliseconds.
+pub const GPU_GRID_CELLS: usize = 512;
+
+/// Append the bound grid of a noise driver's explicit surface around `target` to `d` (the octave
+/// march's skips; [`lodestone_core::scene::bound_grid`]) when the march is fast and the scene has
+/// relief: the pyramid's levels one after the other, `[lo, hi]` per cell, in coordinates relative to
+/// `target` like the waves. Nothing otherwise (`grid_n` stays 0: no skips).
+pub fn push_bound_grid(
+    prepared: &Evaluator,
+    target: [f64; 2],
+    features: FeatureSet,
+    d: &mut MaterialData,
+) {
+    let s = &prepared.surface;
+    let DriverField::Noise(noise) = &s.driver else {
+        return;
+    };
+    if s.march != March::Fast || !features.contains(Feature::Relief) || !(s.sigma_h > 0.0) {
+        return;
+    }
+    let centre = DVec2::from(target);
+    let Some(grid) = BoundGrid::around(noise, centre, GPU_GRID_CELLS) else {
+        return;
+    };
+    let start = d.data.len();
+    d.params.grid_offset = start as u32;
+    for level in &grid.levels {
+        for r in level {
+            d.data.extend(r);
+        }
+    }
+    d.segments.push(("bound grid", (d.data.len() - start) * 4));
+    d.params.grid_n = grid.n as u32;
+    d.params.grid_levels = grid.levels.len() as u32;
+    d.params.grid_cell = grid.cell as f32;
+    d.params.grid_x0 = (grid.origin.x - centre.x) as f32;
+    d.params.grid_y0 = (grid.origin.y - centre.y) as f32;
+    d.params.grid_amp = noise.waves.iter().map(|w| w.amplitude.abs()).sum::<f64>() as f32;
 }
 
 impl GpuMaterial {
@@ -608,11 +658,13 @@ impl GpuMaterial {
         } else {
             features
         };
+        let mut d = material_data_for(prepared, target, uses);
+        push_bound_grid(prepared, target, uses, &mut d);
         let MaterialData {
             mut data,
             params,
             segments,
-        } = material_data_for(prepared, target, uses);
+        } = d;
         if data.is_empty() {
             data.push(0.0);
         }

@@ -42,6 +42,7 @@ pub const MATERIAL_FILES: &[(&str, &str)] = wgsl_files![
     "driver/noise.wgsl",
     "driver/field.wgsl",
     "scene/direction.wgsl",
+    "scene/bound_grid.wgsl",
     "scene/march.wgsl",
     "scene/octave_march.wgsl",
     "scene/surface.wgsl",

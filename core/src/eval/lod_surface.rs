@@ -6,6 +6,7 @@ use crate::driver::field::DriverField;
 use crate::driver::footprint::Footprint;
 use crate::eval::Evaluator;
 use crate::eval::compiled::CompiledTransfer;
+use crate::scene::bound_grid::GridView;
 use crate::scene::march::{March, march_heightfield};
 use crate::scene::octave_march::LocalSlope;
 use glam::{DVec2, DVec3};
@@ -46,6 +47,17 @@ impl Evaluator {
                 {
                     os.g_slope = Some(LocalSlope::level_of_detail(poly, table, sf, s.g_lip));
                 }
+                let total = n.waves.iter().map(|w| w.amplitude.abs()).sum();
+                let shift = n
+                    .waves
+                    .iter()
+                    .zip(&att)
+                    .map(|(w, g)| w.amplitude.abs() * (1.0 - g))
+                    .sum();
+                os.grid = s
+                    .grid
+                    .as_ref()
+                    .map(|g| GridView::level_of_detail(g, fp, total, shift));
                 let height_of = |m| s.sigma_h * self.transfer.moments(m, sf).mean;
                 return os.march(o, d, height_of, s.march);
             }

@@ -72,6 +72,20 @@ pub struct SurfaceStats {
 }
 
 impl Curve {
+    /// `Some(true)` when g never decreases, `Some(false)` when it never increases (a constant curve
+    /// is non-decreasing), `None` otherwise: the control points' g in that order, which both
+    /// interpolations keep (linear segments; Fritsch–Carlson never overshoots monotone data).
+    pub fn monotone(&self) -> Option<bool> {
+        let steps = || self.points.windows(2).map(|w| w[1][1] - w[0][1]);
+        if steps().all(|d| d >= 0.0) {
+            Some(true)
+        } else if steps().all(|d| d <= 0.0) {
+            Some(false)
+        } else {
+            None
+        }
+    }
+
     /// Normalise so that `g(X)`, `X ~ N(0, 1)`, has mean 0 and std 1: σ_h then keeps its meaning as
     /// the height standard deviation of the surface. Curves that are constant stay unchanged.
     pub fn normalized(mut self) -> Self {

@@ -2,6 +2,7 @@
 //! pixel footprints, the closed set of shapes (plane, cylinder) and the explicit micro-geometry
 //! ([`surface::Surface`]) with its rigorous ray march.
 
+pub mod bound_grid;
 pub mod camera;
 pub mod cylinder;
 pub mod direction;

@@ -21,6 +21,19 @@
 //! level-of-detail surface far away, where the footprint has attenuated every wave, it is thin, so
 //! the far field costs a step or two by construction.
 //!
+//! For a transfer curve, `g_lip` is the steepest riser's slope, far above g′ on the curve's flats.
+//! [`LocalSlope`] bounds |g′| over an interval of f exactly (g′ is piecewise quadratic); along a trial
+//! step of length s the level's f stays within `f_l ± (R_l + K_l s)`, so both bounds hold there with
+//! that local constant, and the step they give is safe as long as it does not outrun its trial
+//! ([`OctaveSurface::local_step`]).
+//!
+//! With a [`GridView`] (a min–max pyramid of f over a region, [`crate::scene::bound_grid`]), every
+//! iteration after the first first tries to skip: a segment of the ray is clear when its lowest z
+//! is above the highest surface the grid's range of f over the segment's box allows; clear segments
+//! double and failed ones halve down to one cell ([`OctaveSurface::grid_skip`]). The empty part of
+//! the slab then costs a few lookups instead of many Lipschitz steps, and the waves are summed only
+//! near the surface.
+//!
 //! A ray that starts clear of the surface (gap > 1000 ε at t = 0: a camera ray) stops as soon as the
 //! exact gap is within `ε = HIT_GAP·top` of it, on the surface to within shading precision, instead of
 //! stepping across and refining the bracket (a third of the work at 30–60°). A ray that leaves the
@@ -38,7 +51,8 @@
 use crate::driver::noise::{MAX_LEVELS, Wave};
 use crate::material::preconvolved::PreconvolvedTable;
 use crate::math::piecewise::PiecewisePoly;
-use crate::scene::march::{March, refine};
+use crate::scene::bound_grid::GridView;
+use crate::scene::march::{FAST_WIDTH, March, refine};
 use glam::{DVec2, DVec3};
 use std::f64::consts::TAU;
 
@@ -65,6 +79,10 @@ pub struct OctaveSurface<'a> {
     pub g_lip: f64,
     /// Whether G is the identity (then the gap's slope is used with its sign).
     pub linear: bool,
+    /// `Some(true)` when G never decreases (the identity, a rising curve, and then its footprint
+    /// mean too), `Some(false)` when it never increases, `None` otherwise: the grid's highest
+    /// surface over a range of f is then G at one end.
+    pub monotone: Option<bool>,
     /// Rigorous bound on |h|: the slab the ray leaves.
     pub h_max: f64,
     /// Minimum step.
@@ -72,7 +90,12 @@ pub struct OctaveSurface<'a> {
     /// Local Lipschitz constants of G for a transfer curve (`None` for the identity): the march
     /// then steps with max|G′| over the range f can reach in the step instead of `g_lip`.
     pub g_slope: Option<LocalSlope<'a>>,
+    /// Bounds of f over boxes, to skip what they prove clear ([`crate::scene::bound_grid`]).
+    pub grid: Option<GridView<'a>>,
 }
+
+/// Most grid lookups per [`OctaveSurface::grid_skip`].
+pub const GRID_TRIES: usize = 24;
 
 /// A bound of |G′| over an interval of f, for the octave march's local steps: the largest |g′| over
 /// the interval widened by `widen` (exact for the curve's piecewise quadratic g′,
@@ -213,16 +236,32 @@ impl OctaveSurface<'_> {
             let z = o.z + d.z * t;
             z - height_of(partial(t, 0, rw.terms.len()).0)
         };
+        // The exact gap with f's slope along the ray.
+        let exact = |t: f64| {
+            let (f, fd) = partial(t, 0, rw.terms.len());
+            (o.z + d.z * t - height_of(f), fd)
+        };
         let (mut t, mut prev_t, mut prev_g) = (0.0f64, 0.0f64, 0.0f64);
         let mut j = 0usize;
         // A ray that starts clear of the surface (a camera ray from the slab's top) may settle on it
         // (module docs); one leaving the surface (a shadow ray) must cross it to be stopped.
         let settle = HIT_GAP * top;
         let mut may_settle = None;
+        let mut skip = 0.0;
         for _ in 0..1_000_000 {
             let z = o.z + d.z * t;
             if (d.z >= 0.0 && z > top) || (d.z < 0.0 && z < -top - 1.0) {
                 return None;
+            }
+            // After the first evaluation (which decides whether the ray may settle), skip what the
+            // grid proves clear.
+            if let (Some(gv), Some(_)) = (self.grid, may_settle)
+                && let Some((t1, g1)) = self.grid_skip(&gv, o, d, t, &mut skip, &height_of)
+            {
+                prev_t = t1;
+                prev_g = g1;
+                t = t1;
+                continue;
             }
             let (mut f, mut fd) = (0.0, 0.0);
             let mut start = 0;
@@ -252,6 +291,12 @@ impl OctaveSurface<'_> {
                         return Some(refine(&exact_gap, (prev_t, prev_g), (t, gap), march));
                     }
                     gap = 0.0;
+                }
+                if l == last
+                    && t > 0.0
+                    && let Some(hit) = self.converge(&exact, t, gap, fd, rw.curv[l], d.z)
+                {
+                    return Some(hit);
                 }
                 let found =
                     (gap >= 0.0).then(|| (self.step(gap, fd, rw.lip[l], rw.curv[l], d.z, sg), gap));
@@ -332,6 +377,115 @@ impl OctaveSurface<'_> {
             f64::INFINITY
         };
         first.max(second)
+    }
+
+    /// Near a transversal crossing of a linear G (the identity), the first crossing directly: with
+    /// the exact gap `γ = gap > 0`, its descent rate `β = σ_h f′ − d_z` and `|γ″| ≤ 2c`
+    /// (`c = σ_h M/2`, M the ray's curvature bound `curv`), `γ(t + s) ≤ γ − βs + cs²`, which
+    /// reaches 0 at `s_hi = 2γ/(β + √(β² − 4cγ))` when `β² ≥ 4cγ`, and `γ′ ≤ −β + 2cs < 0` up to
+    /// there. So the first crossing is the only one in `(t, t + s_hi]`, where γ decreases
+    /// strictly: safeguarded Newton (bisection when it leaves the bracket, half a width inside it
+    /// so a converged step closes it) finds it to [`FAST_WIDTH`] in two or three evaluations of
+    /// `exact` (gap and f′ at a t), instead of more safe steps, a crossing and [`refine`]. `None`
+    /// when the conditions do not hold (then the march goes on as before).
+    fn converge(
+        &self,
+        exact: &impl Fn(f64) -> (f64, f64),
+        t: f64,
+        gap: f64,
+        fd: f64,
+        curv: f64,
+        dz: f64,
+    ) -> Option<f64> {
+        if !self.linear || !(gap > 0.0) {
+            return None;
+        }
+        let beta = self.sigma_h * fd - dz;
+        let c = 0.5 * self.sigma_h * curv;
+        let disc = beta * beta - 4.0 * c * gap;
+        if !(beta > 0.0 && disc >= 0.0) {
+            return None;
+        }
+        let mut b = t + 2.0 * gap / (beta + disc.sqrt());
+        let width = FAST_WIDTH * b.abs().max(1.0);
+        let (mut a, mut x, mut gx, mut rx) = (t, t, gap, beta);
+        for _ in 0..64 {
+            if b - a <= width {
+                break;
+            }
+            let mut m = x + gx / rx;
+            if !(m > a && m < b) {
+                m = 0.5 * (a + b);
+            }
+            m = m.clamp(a + 0.5 * width, b - 0.5 * width);
+            let (gm, fm) = exact(m);
+            if gm >= 0.0 {
+                a = m;
+            } else {
+                b = m;
+            }
+            // γ decreases strictly here: a rate that rounding makes non-positive bisects next.
+            (x, gx, rx) = (m, gm, (self.sigma_h * fm - dz).max(f64::MIN_POSITIVE));
+        }
+        Some(a)
+    }
+
+    /// The furthest `t1 > t` to which [`GridView`] proves the ray clear of the surface, with the
+    /// gap's lower bound there, or `None`. Segments from the last clear point double while they are
+    /// clear and halve when not, down to one cell (`len` carries the length between calls).
+    fn grid_skip(
+        &self,
+        gv: &GridView,
+        o: DVec3,
+        d: DVec3,
+        t: f64,
+        len: &mut f64,
+        height_of: &impl Fn(f64) -> f64,
+    ) -> Option<(f64, f64)> {
+        let cell = gv.grid.cell;
+        let mut best: Option<(f64, f64)> = None;
+        let mut l = len.max(2.0 * cell);
+        for _ in 0..GRID_TRIES {
+            let t0 = best.map_or(t, |b| b.0);
+            let t1 = t0 + l;
+            match self.grid_gap(gv, o + d * t0, o + d * t1, height_of) {
+                Some(g) if g > 0.0 => {
+                    best = Some((t1, g));
+                    l *= 2.0;
+                }
+                _ => {
+                    if l <= cell {
+                        break;
+                    }
+                    l *= 0.5;
+                }
+            }
+        }
+        *len = l;
+        best
+    }
+
+    /// A lower bound of the gap along the segment from `a` to `b` from the grid's range of f over
+    /// its box: the segment's lowest z minus the highest surface that range allows (`σ_h·G(hi)`
+    /// for the identity and rising curves; `σ_h·(G(mid) + L·(hi − lo)/2)` with the local Lipschitz constant L of a
+    /// curve; G at one end of the range when G is monotone). `None` where the box leaves the grid.
+    fn grid_gap(
+        &self,
+        gv: &GridView,
+        a: DVec3,
+        b: DVec3,
+        height_of: &impl Fn(f64) -> f64,
+    ) -> Option<f64> {
+        let (lo, hi) = gv.range(DVec2::new(a.x, a.y), DVec2::new(b.x, b.y))?;
+        let h = if let Some(rising) = self.monotone {
+            height_of(if rising { hi } else { lo })
+        } else {
+            let l = self
+                .g_slope
+                .map_or(self.g_lip, |gs| gs.lipschitz_on(lo, hi).min(self.g_lip));
+            height_of(0.5 * (lo + hi)) + self.sigma_h * l * 0.5 * (hi - lo)
+        };
+        Some(a.z.min(b.z) - h)
     }
 
     /// Improve the level's `(step, gap)` found with the global `g_lip` (`None` when that gap is
@@ -435,6 +589,20 @@ mod tests {
         ]
     }
 
+    /// Each material twice: without and with a bound grid.
+    fn gridded(ms: Vec<Material>) -> Vec<(Material, bool)> {
+        ms.into_iter()
+            .flat_map(|m| [(m.clone(), false), (m, true)])
+            .collect()
+    }
+
+    /// A bound grid over [3, 27]²: part of the rays' range, so rays also cross its edge.
+    fn with_grid(s: Surface) -> Surface {
+        let s = s.with_bound_grid(DVec2::splat(15.0), 12.0);
+        assert!(s.grid.is_some());
+        s
+    }
+
     fn with_march(s: &Surface, march: March) -> Surface {
         Surface { march, ..s.clone() }
     }
@@ -446,9 +614,10 @@ mod tests {
     #[test]
     fn the_octave_march_finds_the_reference_crossing() {
         let mut rng = 5u64;
-        for m in materials() {
+        for (m, grid) in gridded(materials()) {
             let fast = Surface::new(&m).unwrap();
             assert_eq!(fast.march, March::Fast);
+            let fast = if grid { with_grid(fast) } else { fast };
             assert!(fast.octaves(None).is_some());
             let reference = with_march(&fast, March::Reference);
             let (mut hits, mut shadows, mut differ) = (0, 0, 0);
@@ -490,7 +659,7 @@ mod tests {
             // the surface, where either may take the sliver: allow one ray in 400.
             assert!(
                 differ <= 1,
-                "{}: {differ} of {} rays differ",
+                "{} (grid {grid}): {differ} of {} rays differ",
                 m.name,
                 hits + shadows
             );
@@ -502,8 +671,9 @@ mod tests {
     #[test]
     fn the_octave_march_never_steps_over_a_crossing() {
         let mut rng = 9u64;
-        for m in materials() {
+        for (m, grid) in gridded(materials()) {
             let s = Surface::new(&m).unwrap();
+            let s = if grid { with_grid(s) } else { s };
             for i in 0..60 {
                 let theta = (70.0 + 19.0 * (i % 10) as f64 / 9.0).to_radians();
                 let d = -direction(theta, TAU * splitmix(&mut rng));
@@ -532,10 +702,13 @@ mod tests {
     #[test]
     fn the_octave_march_finds_the_reference_crossing_on_the_level_of_detail_surface() {
         let mut rng = 17u64;
-        for m in materials() {
-            let fast = Evaluator::new(&m).unwrap();
+        for (m, grid) in gridded(materials()) {
+            let mut fast = Evaluator::new(&m).unwrap();
             let mut reference = fast.clone();
             reference.surface.march = March::Reference;
+            if grid {
+                fast.surface = with_grid(fast.surface.clone());
+            }
             let scale = fast.surface.driver.finest_scale();
             let mut differ = 0;
             for i in 0..240 {
@@ -558,7 +731,55 @@ mod tests {
                 let gap = p.z - fast.lod_height(DVec2::new(p.x, p.y), fp);
                 assert!(gap.abs() < 1e-9, "{}: off h̄ by {gap}", m.name);
             }
-            assert!(differ <= 1, "{}: {differ} of 240 rays differ", m.name);
+            assert!(
+                differ <= 1,
+                "{} (grid {grid}): {differ} of 240 rays differ",
+                m.name
+            );
+        }
+    }
+
+    /// The grid does its job: from the slab's top, the first skip of a primary ray (20°–80°) covers
+    /// most of the way to the hit on the Gaussian materials (the part of the slab above the local
+    /// relief), and never reaches past it.
+    #[test]
+    fn the_grid_skips_most_of_the_empty_slab() {
+        let mut rng = 3u64;
+        for m in materials().into_iter().take(2) {
+            let s = with_grid(Surface::new(&m).unwrap());
+            let os = s.octaves(None).unwrap();
+            let gv = os.grid.unwrap();
+            let height_of = |f| s.height_of(f);
+            let (mut covered, mut n) = (0.0, 0);
+            for i in 0..100 {
+                let theta = (20.0 + 60.0 * (i % 7) as f64 / 6.0).to_radians();
+                let d = -direction(theta, TAU * splitmix(&mut rng));
+                let o = DVec3::new(
+                    10.0 + 10.0 * splitmix(&mut rng),
+                    10.0 + 10.0 * splitmix(&mut rng),
+                    s.h_max * 1.001 + 1e-6,
+                );
+                let Trace::Hit(t) = s.march(o, d) else {
+                    panic!("hits")
+                };
+                let mut len = 0.0;
+                let skipped = os
+                    .grid_skip(&gv, o, d, 0.0, &mut len, &height_of)
+                    .map_or(0.0, |(t1, _)| t1);
+                assert!(
+                    skipped <= t,
+                    "{}: skipped to {skipped} past the hit at {t}",
+                    m.name
+                );
+                covered += skipped / t;
+                n += 1;
+            }
+            let mean = covered / f64::from(n);
+            assert!(
+                mean > 0.5,
+                "{}: the first skip covers {mean:.2} of the way",
+                m.name
+            );
         }
     }
 

@@ -10,6 +10,7 @@ use crate::driver::field::DriverField;
 use crate::material::Material;
 use crate::material::transfer::TransferFunction;
 use crate::math::piecewise::PiecewisePoly;
+use crate::scene::bound_grid::{BoundGrid, GridView};
 use crate::scene::march::{March, march_heightfield};
 use crate::scene::octave_march::{LocalSlope, OctaveSurface};
 use glam::{DVec2, DVec3};
@@ -37,6 +38,9 @@ pub struct Surface {
     /// A transfer curve's [`crate::material::transfer::Curve::moment_poly`], built once (`None` for the identity): g and the
     /// fast march's local Lipschitz constants of g ([`LocalSlope`]).
     pub transfer_poly: Option<PiecewisePoly>,
+    /// Bounds of a noise driver over a region, which the octave march uses to skip what is clear
+    /// ([`Surface::with_bound_grid`]; `None`: no skipping).
+    pub grid: Option<BoundGrid>,
 }
 
 /// Result of marching a ray.
@@ -79,6 +83,7 @@ impl Surface {
         Self {
             levels,
             transfer_poly,
+            grid: None,
             g_lip: transfer.max_derivative(),
             driver,
             sigma_h,
@@ -165,6 +170,10 @@ impl Surface {
             sigma_h: self.sigma_h,
             g_lip: self.g_lip,
             linear: matches!(self.transfer, TransferFunction::Identity),
+            monotone: match &self.transfer {
+                TransferFunction::Identity => Some(true),
+                TransferFunction::Curve(c) => c.monotone(),
+            },
             h_max: self.h_max,
             min_step: self.min_step,
             g_slope: self.transfer_poly.as_ref().map(|poly| LocalSlope {
@@ -172,7 +181,17 @@ impl Surface {
                 widen: 0.0,
                 tail: 0.0,
             }),
+            grid: self.grid.as_ref().map(GridView::explicit),
         })
+    }
+
+    /// This surface with a [`BoundGrid`] of its noise driver over the square of half-width `half`
+    /// around `centre` (unchanged for an image driver).
+    pub fn with_bound_grid(mut self, centre: DVec2, half: f64) -> Self {
+        if let DriverField::Noise(n) = &self.driver {
+            self.grid = BoundGrid::build(n, centre, half);
+        }
+        self
     }
 
     /// Whether the point p (on the surface) sees direction d (unit): false if d is at or below the

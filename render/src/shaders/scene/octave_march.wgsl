@@ -189,6 +189,102 @@ fn octave_local_step(found_in: vec3<f32>, above: f32, f: f32, fd: f32, lip: f32,
     return found;
 }
 
+// OctaveSurface::converge: for the identity transfer near a transversal crossing (β² ≥ 4cγ), the
+// first crossing is the only one in (t, t + s_hi] and the gap decreases strictly there: safeguarded
+// Newton to FAST_WIDTH, returning the last point above; -1 when the conditions do not hold.
+fn octave_converge(o: vec3<f32>, d: vec3<f32>, t: f32, gap: f32, fd: f32, curv: f32, lod: bool, sf: f32) -> f32 {
+    if (params.transfer_kind != TRANSFER_IDENTITY || !(gap > 0.0)) {
+        return -1.0;
+    }
+    let beta = params.sigma_h * fd - d.z;
+    let c = 0.5 * params.sigma_h * curv;
+    let disc = beta * beta - 4.0 * c * gap;
+    if (!(beta > 0.0 && disc >= 0.0)) {
+        return -1.0;
+    }
+    var b = t + 2.0 * gap / (beta + sqrt(disc));
+    let width = FAST_WIDTH * max(abs(b), 1.0);
+    var a = t;
+    var x = t;
+    var gx = gap;
+    var rx = beta;
+    let n = octave_count(lod);
+    for (var i = 0u; i < 64u; i = i + 1u) {
+        if (b - a <= width) {
+            break;
+        }
+        var m = x + gx / rx;
+        if (!(m > a && m < b)) {
+            m = 0.5 * (a + b);
+        }
+        m = clamp(m, a + 0.5 * width, b - 0.5 * width);
+        let q = o + d * m;
+        let fm = octave_partial(0u, n, q.xy, d.xy, lod);
+        let gm = q.z - octave_height(fm.x, lod, sf);
+        if (gm >= 0.0) {
+            a = m;
+        } else {
+            b = m;
+        }
+        x = m;
+        gx = gm;
+        // The gap decreases strictly here: a rate that rounding makes non-positive bisects next.
+        rx = max(params.sigma_h * fm.y - d.z, 1e-30);
+    }
+    return a;
+}
+
+// OctaveSurface::grid_gap: a lower bound of the gap along the segment from a to b from the grid's
+// range of f over its box, as (gap, 1), or (0, 0) outside the grid. On the level-of-detail surface
+// the box is dilated by lod_dilate and the range tightened by lod_shift (GridView::level_of_detail). GPU only: a margin of
+// GRID_MARGIN·Σ|a_i| for the f32 sums (phases near the target are accurate to ~1e-5 rad).
+fn octave_grid_gap(a: vec3<f32>, b: vec3<f32>, lod: bool, sf: f32) -> vec2<f32> {
+    var dilate = vec2<f32>(0.0);
+    var tail = GRID_MARGIN * params.grid_amp;
+    var shift = -1.0;
+    if (lod) {
+        dilate = lod_dilate;
+        tail = tail + 8e-9 * params.grid_amp;
+        shift = lod_shift;
+    }
+    let r = grid_view_range(a.xy, b.xy, dilate, tail, shift);
+    if (r.z == 0.0) {
+        return vec2<f32>(0.0);
+    }
+    var h = octave_height(r.y, lod, sf);
+    if (params.transfer_monotone == 2u) {
+        h = octave_height(r.x, lod, sf);
+    } else if (params.transfer_monotone == 0u) {
+        let l = octave_lipschitz_on(r.x, r.y, lod, sf);
+        h = octave_height(0.5 * (r.x + r.y), lod, sf) + params.sigma_h * l * 0.5 * (r.y - r.x);
+    }
+    return vec2<f32>(min(a.z, b.z) - h, 1.0);
+}
+
+// OctaveSurface::grid_skip: (t1, gap, 1) at the furthest point the grid proves the ray clear to, or
+// (t, 0, 0); segments double while clear and halve when not, down to one cell (len carries the
+// length between calls).
+fn octave_grid_skip(o: vec3<f32>, d: vec3<f32>, t: f32, len: ptr<function, f32>, lod: bool, sf: f32) -> vec3<f32> {
+    let cell = params.grid_cell;
+    var best = vec3<f32>(t, 0.0, 0.0);
+    var l = max(*len, 2.0 * cell);
+    for (var i = 0u; i < GRID_TRIES; i = i + 1u) {
+        let t1 = best.x + l;
+        let g = octave_grid_gap(o + d * best.x, o + d * t1, lod, sf);
+        if (g.y > 0.0 && g.x > 0.0) {
+            best = vec3<f32>(t1, g.x, 1.0);
+            l = l * 2.0;
+        } else {
+            if (l <= cell) {
+                break;
+            }
+            l = l * 0.5;
+        }
+    }
+    *len = l;
+    return best;
+}
+
 // OctaveSurface::march on the explicit (lod = false) or level-of-detail surface (lod = true, after
 // lod_prepare, whose σ_f is sf): t of the first crossing, or -1 when the ray leaves the slab.
 fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
@@ -207,10 +303,22 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
     // A camera ray may settle on the surface; a shadow ray must cross it (core's module docs).
     let settle = HIT_GAP * top;
     var may_settle = 0u;
+    var skip = 0.0;
     for (var it = 0u; it < 20000u; it = it + 1u) {
         let p = o + d * t;
         if ((d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0)) {
             return -1.0;
+        }
+        // After the first evaluation (which decides whether the ray may settle), skip what the
+        // grid proves clear.
+        if (params.grid_n > 0u && may_settle != 0u) {
+            let sk = octave_grid_skip(o, d, t, &skip, lod, sf);
+            if (sk.z > 0.0) {
+                prev_t = sk.x;
+                prev_g = sk.y;
+                t = sk.x;
+                continue;
+            }
         }
         var acc = vec2<f32>(0.0);
         var start = 0u;
@@ -236,6 +344,12 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
                 }
                 // The origin is on the surface by contract: a negative gap here is rounding.
                 gap = 0.0;
+            }
+            if (l == last && t > 0.0) {
+                let hit = octave_converge(o, d, t, gap, acc.y, rw.curv[l], lod, sf);
+                if (hit >= 0.0) {
+                    return hit;
+                }
             }
             var found = vec3<f32>(0.0);
             if (gap >= 0.0) {
