@@ -43,6 +43,7 @@ pub const MATERIAL_FILES: &[(&str, &str)] = wgsl_files![
     "driver/field.wgsl",
     "scene/direction.wgsl",
     "scene/bound_grid.wgsl",
+    "scene/local_slope.wgsl",
     "scene/march.wgsl",
     "scene/octave_march.wgsl",
     "scene/surface.wgsl",

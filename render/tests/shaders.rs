@@ -97,7 +97,7 @@ const MIRRORS: &[(&str, &str, &str, &str)] = &[
     ("scene/octave_march.wgsl", "octave_grid_skip", "scene/octave_march.rs", "grid_skip"),
     ("scene/bound_grid.wgsl", "grid_range", "scene/bound_grid.rs", "range"),
     ("scene/bound_grid.wgsl", "grid_view_range", "scene/bound_grid.rs", "range"),
-    ("scene/octave_march.wgsl", "octave_lipschitz_on", "scene/octave_march.rs", "lipschitz_on"),
+    ("scene/local_slope.wgsl", "lipschitz_on", "scene/local_slope.rs", "lipschitz_on"),
     ("scene/octave_march.wgsl", "octave_local_step", "scene/octave_march.rs", "local_step"),
     ("scene/octave_march.wgsl", "octave_march", "scene/octave_march.rs", "march"),
     ("scene/octave_march.wgsl", "level_end", "driver/noise.rs", "level_ends"),

@@ -7,8 +7,8 @@ use crate::driver::footprint::Footprint;
 use crate::eval::Evaluator;
 use crate::eval::compiled::CompiledTransfer;
 use crate::scene::bound_grid::GridView;
+use crate::scene::local_slope::LocalSlope;
 use crate::scene::march::{March, march_heightfield};
-use crate::scene::octave_march::LocalSlope;
 use glam::{DVec2, DVec3};
 
 impl Evaluator {

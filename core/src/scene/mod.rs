@@ -6,6 +6,7 @@ pub mod bound_grid;
 pub mod camera;
 pub mod cylinder;
 pub mod direction;
+pub mod local_slope;
 pub mod march;
 pub mod octave_march;
 pub mod shape;

@@ -49,9 +49,8 @@
 //! [`crate::scene::march::march_heightfield`].
 
 use crate::driver::noise::{MAX_LEVELS, Wave};
-use crate::material::preconvolved::PreconvolvedTable;
-use crate::math::piecewise::PiecewisePoly;
 use crate::scene::bound_grid::GridView;
+use crate::scene::local_slope::LocalSlope;
 use crate::scene::march::{FAST_WIDTH, March, refine};
 use glam::{DVec2, DVec3};
 use std::f64::consts::TAU;
@@ -96,54 +95,6 @@ pub struct OctaveSurface<'a> {
 
 /// Most grid lookups per [`OctaveSurface::grid_skip`].
 pub const GRID_TRIES: usize = 24;
-
-/// A bound of |G′| over an interval of f, for the octave march's local steps: the largest |g′| over
-/// the interval widened by `widen` (exact for the curve's piecewise quadratic g′,
-/// [`PiecewisePoly::max_abs_on`]), plus `tail`, never more than the global `g_lip`.
-///
-/// On the explicit surface G = g (`widen = tail = 0`). On the level-of-detail surface G(m) is the
-/// table of `E[g(m + σ_f Z)]`, interpolated between nodes; its slope between nodes is
-/// `E[g′(m′ + σ′Z)]` at some node-interval point m′ and row σ′ ≤ σ_f + Δσ, at most the largest |g′|
-/// within 6(σ_f + Δσ) of the interval widened by one column Δm, plus `g_lip·P(|Z| > 6) < 2e-9·g_lip`.
-#[derive(Clone, Copy, Debug)]
-pub struct LocalSlope<'a> {
-    /// The curve's [`crate::material::transfer::Curve::moment_poly`] (channel 2 is g′).
-    pub poly: &'a PiecewisePoly,
-    /// How far the interval is widened on either side.
-    pub widen: f64,
-    /// Added to the bound.
-    pub tail: f64,
-}
-
-impl<'a> LocalSlope<'a> {
-    /// The channel of g′ in [`crate::material::transfer::Curve::moment_poly`].
-    pub const DERIVATIVE_CHANNEL: usize = 2;
-
-    /// The bound for the level-of-detail surface, whose G is `table` (the curve's pre-convolved
-    /// moments) at σ_f = `sf`: widened by `6(σ_f + Δσ) + Δm` with `tail = 2e-9·g_lip` (struct docs).
-    pub fn level_of_detail(
-        poly: &'a PiecewisePoly,
-        table: &PreconvolvedTable,
-        sf: f64,
-        g_lip: f64,
-    ) -> Self {
-        let dm = (table.m_max - table.m_min) / (table.size_m.max(2) - 1) as f64;
-        let ds = table.sigma_max / (table.size_sigma.max(2) - 1) as f64;
-        Self {
-            poly,
-            widen: 6.0 * (sf.max(0.0) + ds) + dm.abs(),
-            tail: 2e-9 * g_lip,
-        }
-    }
-
-    /// A bound of |G′| on [lo, hi] (before the cap at the global `g_lip`).
-    pub fn lipschitz_on(&self, lo: f64, hi: f64) -> f64 {
-        self.poly
-            .max_abs_on(Self::DERIVATIVE_CHANNEL, lo - self.widen, hi + self.widen)
-            * (1.0 + 1e-9)
-            + self.tail
-    }
-}
 
 /// Per-ray constants of the waves: amplitudes, frequencies along the ray and the level bounds.
 struct RayWaves {

@@ -11,8 +11,9 @@ use crate::material::Material;
 use crate::material::transfer::TransferFunction;
 use crate::math::piecewise::PiecewisePoly;
 use crate::scene::bound_grid::{BoundGrid, GridView};
+use crate::scene::local_slope::LocalSlope;
 use crate::scene::march::{March, march_heightfield};
-use crate::scene::octave_march::{LocalSlope, OctaveSurface};
+use crate::scene::octave_march::OctaveSurface;
 use glam::{DVec2, DVec3};
 
 /// The explicit heightfield of a material.

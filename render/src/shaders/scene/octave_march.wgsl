@@ -137,26 +137,6 @@ fn octave_step(gap: f32, fd: f32, lip: f32, curv: f32, dz: f32, sg: f32) -> f32 
     return max(first, second);
 }
 
-// LocalSlope::lipschitz_on (with LocalSlope::level_of_detail's widening when lod): a bound of |G′|
-// over [lo, hi] for a transfer curve, at most g_lip; g_lip for the identity.
-fn octave_lipschitz_on(lo: f32, hi: f32, lod: bool, sf: f32) -> f32 {
-//#if transfer_curve
-    if (params.transfer_kind != TRANSFER_IDENTITY) {
-        var widen = 0.0;
-        var tail = 0.0;
-        if (lod) {
-            let dm = (params.tt_m_max - params.tt_m_min) / f32(max(params.tt_size_m, 2u) - 1u);
-            let ds = params.tt_sigma_max / f32(max(params.tt_size_s, 2u) - 1u);
-            widen = 6.0 * (sf + ds) + dm;
-            tail = 2e-9 * params.g_lip;
-        }
-        let g = poly_max_abs_on(params.tp_offset, params.tp_knots, 2u, 1u, lo - widen, hi + widen);
-        return min(g * (1.0 + 1e-5) + tail, params.g_lip);
-    }
-//#endif
-    return params.g_lip;
-}
-
 // OctaveSurface::local_step: lengthen the level's (step, gap, found) by the local Lipschitz constant
 // of G over the range f can reach in trial steps growing 8× (at most four); above = z − σ_h·G(f_l).
 fn octave_local_step(found_in: vec3<f32>, above: f32, f: f32, fd: f32, lip: f32, curv: f32, resid: f32, dz: f32, lod: bool, sf: f32, min_step: f32) -> vec3<f32> {
@@ -168,7 +148,7 @@ fn octave_local_step(found_in: vec3<f32>, above: f32, f: f32, fd: f32, lip: f32,
     var trial = 8.0 * max(select(0.0, found.x, found.z > 0.0), min_step);
     for (var i = 0u; i < 4u; i = i + 1u) {
         let reach = resid + lip * trial;
-        let sg = params.sigma_h * octave_lipschitz_on(f - reach, f + reach, lod, sf);
+        let sg = params.sigma_h * lipschitz_on(f - reach, f + reach, lod, sf);
         let gap = above - sg * resid;
         if (!(gap >= 0.0)) {
             break;
@@ -255,7 +235,7 @@ fn octave_grid_gap(a: vec3<f32>, b: vec3<f32>, lod: bool, sf: f32) -> vec2<f32> 
     if (params.transfer_monotone == 2u) {
         h = octave_height(r.x, lod, sf);
     } else if (params.transfer_monotone == 0u) {
-        let l = octave_lipschitz_on(r.x, r.y, lod, sf);
+        let l = lipschitz_on(r.x, r.y, lod, sf);
         h = octave_height(0.5 * (r.x + r.y), lod, sf) + params.sigma_h * l * 0.5 * (r.y - r.x);
     }
     return vec2<f32>(min(a.z, b.z) - h, 1.0);
