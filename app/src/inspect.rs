@@ -67,9 +67,9 @@ pub fn inspect(preset: &Resolved, opts: Options) -> Result<Inspection> {
     let target = scene.camera.target;
     let timings = if opts.time {
         let r = renderer()?;
-        let special = GpuMaterial::new(r.context(), &prepared, target);
-        let all = GpuMaterial::all_features(r.context(), &prepared, target);
-        let mut t = ViewTarget::new(&r, opts.size.0, opts.size.1);
+        let special = GpuMaterial::new(r.context(), &prepared, target)?;
+        let all = GpuMaterial::all_features(r.context(), &prepared, target)?;
+        let mut t = ViewTarget::new(&r, opts.size.0, opts.size.1)?;
         // Pipeline creation and the first frame: drivers may compile lazily (Mesa JIT-compiles
         // at the first dispatch), so creation alone would not show the cost. The specialised
         // pipeline goes first and so also carries any one-time warm-up of the device.

@@ -63,10 +63,17 @@ fn main() -> ExitCode {
     }
 }
 
-/// 2 for bad presets, 3 for a missing adapter, else 1.
+/// 2 for bad presets and sizes or materials beyond the adapter's limits, 3 for a missing adapter,
+/// else 1.
 fn exit_code(e: &anyhow::Error) -> u8 {
+    let too_large = |c: &(dyn std::error::Error + 'static)| {
+        matches!(
+            c.downcast_ref::<lodestone_render::renderer::RenderError>(),
+            Some(lodestone_render::renderer::RenderError::TooLarge { .. })
+        )
+    };
     if e.chain()
-        .any(|c| c.is::<MaterialError>() || c.is::<preset_io::PresetError>())
+        .any(|c| c.is::<MaterialError>() || c.is::<preset_io::PresetError>() || too_large(c))
     {
         2
     } else if e.chain().any(|c| c.is::<lodestone_render::GpuError>()) {

@@ -99,7 +99,7 @@ pub fn render(
     prepared.surface.march = view.march;
     let r = renderer()?;
     let scene = view.scene();
-    let gm = GpuMaterial::new(r.context(), &prepared, scene.camera.target);
+    let gm = GpuMaterial::new(r.context(), &prepared, scene.camera.target)?;
     let draw = |m: ViewMode| r.render(&gm, &scene, m, size, spp);
     let draw = |m: ViewMode| -> Result<LinearImage> { Ok(draw(m)?) };
     match mode {
@@ -248,7 +248,7 @@ impl BenchRow {
 pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Result<()> {
     let r = renderer()?;
     let (w, h) = cfg.size;
-    let mut target = ViewTarget::new(&r, w, h);
+    let mut target = ViewTarget::new(&r, w, h)?;
     let mut rows = vec![];
     for (name, preset) in presets {
         let prepared = preset.prepare()?;
@@ -269,9 +269,9 @@ pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Re
                     march: March::Fast,
                 }
                 .scene();
-                let gm = GpuMaterial::new(r.context(), &prepared, scene.camera.target);
-                let gref = GpuMaterial::new(r.context(), &reference, scene.camera.target);
-                let gflat = GpuMaterial::new(r.context(), &flat, scene.camera.target);
+                let gm = GpuMaterial::new(r.context(), &prepared, scene.camera.target)?;
+                let gref = GpuMaterial::new(r.context(), &reference, scene.camera.target)?;
+                let gflat = GpuMaterial::new(r.context(), &flat, scene.camera.target)?;
                 let flat_ms =
                     frame_ms(&r, &mut target, &gflat, &scene, ViewMode::Naive, cfg.frames);
                 let mut time = |g: &GpuMaterial| {

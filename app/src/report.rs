@@ -213,8 +213,8 @@ pub fn run_with(
     };
     let (p_exact, p_paper) = (prepare(&exact)?, prepare(&paper)?);
     let target = [0.3, 0.7];
-    let gm_exact = GpuMaterial::new(r.context(), &p_exact, target);
-    let gm_paper = GpuMaterial::new(r.context(), &p_paper, target);
+    let gm_exact = GpuMaterial::new(r.context(), &p_exact, target)?;
+    let gm_paper = GpuMaterial::new(r.context(), &p_paper, target)?;
     let total = opts.zooms.len() * opts.views.len() * 3;
     let mut configs = Vec::new();
     let mut done = 0;
@@ -249,7 +249,7 @@ pub fn run_with(
                 milestones.push(ref_spp);
                 milestones.sort_unstable();
                 milestones.dedup();
-                let mut tgt = ViewTarget::new(&r, opts.size.0, opts.size.1);
+                let mut tgt = ViewTarget::new(&r, opts.size.0, opts.size.1)?;
                 let mut truth = Vec::new();
                 let mut frame_ms = Vec::new();
                 let mut have = 0;
@@ -291,7 +291,7 @@ pub fn run_with(
                     let mut img = None;
                     let mut times = Vec::new();
                     for _ in 0..opts.repeats.max(1) {
-                        let mut t = ViewTarget::new(&r, opts.size.0, opts.size.1);
+                        let mut t = ViewTarget::new(&r, opts.size.0, opts.size.1)?;
                         times.push(timed(&r, || r.draw(&mut t, gm, &scene, mode, 1)));
                         img = Some(t.read(&r)?);
                     }

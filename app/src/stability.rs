@@ -90,7 +90,10 @@ fn wgsl_material_rows(r: &Renderer) -> Vec<Row> {
                     light,
                     shape: Shape::Plane,
                 };
-                let gm = GpuMaterial::new(r.context(), &p, camera.target);
+                let Ok(gm) = GpuMaterial::new(r.context(), &p, camera.target) else {
+                    bad += 1;
+                    continue;
+                };
                 for mode in [
                     ViewMode::Naive,
                     ViewMode::ViewIndependent,

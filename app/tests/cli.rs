@@ -81,6 +81,41 @@ fn eval_prints_json_with_every_method() {
     assert_eq!(v["samples"].as_u64(), Some(2000));
 }
 
+/// An image beyond what the adapter can bind (8192² needs a 1 GiB accumulation buffer; llvmpipe
+/// binds 128 MiB) is refused before anything is created: exit 2 with the limit, no panic (101) and
+/// no file. An adapter that can bind it renders it.
+#[test]
+fn an_image_beyond_the_adapter_limit_exits_2_with_the_limit() {
+    let dir = std::env::temp_dir().join(format!("lodestone-cli-limit-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("huge.png");
+    let out = lodestone(&[
+        "render",
+        "--size",
+        "8192x8192",
+        "--mode",
+        "naive",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    if out.status.code() == Some(3) {
+        eprintln!("skipping the limit test: no adapter");
+        return;
+    }
+    if err.contains("more than this adapter can bind") {
+        assert_eq!(out.status.code(), Some(2), "{err}");
+        assert!(
+            err.contains("at most") && err.contains("8192×8192"),
+            "{err}"
+        );
+        assert!(!png.exists());
+    } else {
+        assert!(out.status.success(), "{err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn no_adapter_exits_3_with_a_clear_message() {
     // Metal does not exist on Linux or Windows: wgpu finds no adapter at all.

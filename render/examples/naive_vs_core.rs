@@ -29,7 +29,8 @@ fn main() {
         light,
         shape: Shape::Plane,
     };
-    let gm = GpuMaterial::new(r.context(), &p, camera.target);
+    let gm =
+        GpuMaterial::new(r.context(), &p, camera.target).expect("the material fits the adapter");
     let (w, h) = (400u32, 300u32);
     let img = r.render(&gm, &scene, ViewMode::Naive, (w, h), 1).unwrap();
     let mut bad = 0;

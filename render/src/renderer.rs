@@ -36,6 +36,37 @@ pub enum RenderError {
     /// The GPU could not hand the image back (device lost, out of memory, …).
     #[error("reading the image back from the GPU failed: {0}")]
     Readback(String),
+    /// A buffer would exceed what the adapter can bind (checked before anything is created).
+    #[error(
+        "{what} needs {} MiB, more than this adapter can bind ({} MiB){hint}",
+        bytes.div_ceil(1 << 20),
+        limit >> 20
+    )]
+    TooLarge {
+        /// What the buffer is for.
+        what: String,
+        /// Bytes it needs.
+        bytes: u64,
+        /// The adapter's limit in bytes.
+        limit: u64,
+        /// What to do about it ("; at most … pixels" for an image), or empty.
+        hint: String,
+    },
+}
+
+/// Bytes per pixel of a view target's accumulation buffer (linear RGB + sample count, f32).
+pub const BYTES_PER_PIXEL: u64 = 16;
+
+/// The most bytes one storage buffer may hold on `ctx`'s device: the smaller of its binding and
+/// buffer size limits.
+pub fn storage_limit(ctx: &GpuContext) -> u64 {
+    let l = ctx.device.limits();
+    l.max_storage_buffer_binding_size.min(l.max_buffer_size)
+}
+
+/// The most pixels a [`ViewTarget`] may have on `ctx`'s device.
+pub fn max_pixels(ctx: &GpuContext) -> u64 {
+    storage_limit(ctx) / BYTES_PER_PIXEL
 }
 
 /// What a view shows.
@@ -151,13 +182,28 @@ pub struct ViewTarget {
 }
 
 impl ViewTarget {
-    /// A target of `width × height` pixels.
-    pub fn new(renderer: &Renderer, width: u32, height: u32) -> Self {
+    /// A target of `width × height` pixels, or [`RenderError::TooLarge`] when its accumulation
+    /// buffer would exceed what the adapter can bind ([`max_pixels`]): nothing is created then.
+    pub fn new(renderer: &Renderer, width: u32, height: u32) -> Result<Self, RenderError> {
         let device = &renderer.ctx.device;
         let (width, height) = (width.max(1), height.max(1));
+        let bytes = u64::from(width) * u64::from(height) * BYTES_PER_PIXEL;
+        let limit = storage_limit(&renderer.ctx);
+        if bytes > limit {
+            let side = ((limit / BYTES_PER_PIXEL) as f64).sqrt().floor();
+            return Err(RenderError::TooLarge {
+                what: format!("an image of {width}×{height} pixels"),
+                bytes,
+                limit,
+                hint: format!(
+                    "; at most {} pixels here, e.g. {side}×{side}",
+                    limit / BYTES_PER_PIXEL
+                ),
+            });
+        }
         let accum = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("accumulation"),
-            size: u64::from(width) * u64::from(height) * 16,
+            size: bytes,
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
@@ -167,13 +213,13 @@ impl ViewTarget {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Self {
+        Ok(Self {
             width,
             height,
             accum,
             view,
             samples: 0,
-        }
+        })
     }
 
     /// Start accumulating afresh (the next ground-truth frame overwrites instead of adding).
@@ -633,15 +679,24 @@ pub fn push_bound_grid(
 impl GpuMaterial {
     /// Upload a prepared material with coordinates relative to `target` (the camera target), with
     /// only the data its features use ([`material_data_for`]); drawn by pipelines specialised to
-    /// the material and scene.
-    pub fn new(ctx: &GpuContext, prepared: &Evaluator, target: [f64; 2]) -> Self {
+    /// the material and scene. [`RenderError::TooLarge`] (and nothing created) when the data
+    /// exceeds what the adapter can bind in one buffer.
+    pub fn new(
+        ctx: &GpuContext,
+        prepared: &Evaluator,
+        target: [f64; 2],
+    ) -> Result<Self, RenderError> {
         let features = FeatureSet::of_material(&prepared.material);
         Self::upload(ctx, prepared, target, features, false)
     }
 
     /// Upload every table the material has, to be drawn by the all-features pipeline (the
     /// reference the specialised pipelines are compared against, and the engine bundle's shader).
-    pub fn all_features(ctx: &GpuContext, prepared: &Evaluator, target: [f64; 2]) -> Self {
+    pub fn all_features(
+        ctx: &GpuContext,
+        prepared: &Evaluator,
+        target: [f64; 2],
+    ) -> Result<Self, RenderError> {
         let features = FeatureSet::of_material(&prepared.material);
         Self::upload(ctx, prepared, target, features, true)
     }
@@ -652,7 +707,7 @@ impl GpuMaterial {
         target: [f64; 2],
         features: FeatureSet,
         all_features: bool,
-    ) -> Self {
+    ) -> Result<Self, RenderError> {
         let uses = if all_features {
             FeatureSet::all()
         } else {
@@ -667,6 +722,21 @@ impl GpuMaterial {
         } = d;
         if data.is_empty() {
             data.push(0.0);
+        }
+        let limit = storage_limit(ctx);
+        let bytes = (data.len() * 4) as u64;
+        if bytes > limit {
+            let parts = segments
+                .iter()
+                .map(|(name, b)| format!("{name} {} MiB", b.div_ceil(1 << 20)))
+                .collect::<Vec<_>>()
+                .join(", ");
+            return Err(RenderError::TooLarge {
+                what: "the material's data".into(),
+                bytes,
+                limit,
+                hint: format!(" ({parts}); use smaller tables or a smaller image"),
+            });
         }
         let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("material data"),
@@ -684,14 +754,14 @@ impl GpuMaterial {
         });
         ctx.queue
             .write_buffer(&params_buffer, 0, bytemuck::bytes_of(&params));
-        Self {
+        Ok(Self {
             data: buffer,
             params: params_buffer,
             target,
             features,
             all_features,
             segments,
-        }
+        })
     }
 
     /// The camera target the data was uploaded for.
@@ -801,7 +871,7 @@ impl Renderer {
         (width, height): (u32, u32),
         samples: u32,
     ) -> Result<LinearImage, RenderError> {
-        let mut target = ViewTarget::new(self, width, height);
+        let mut target = ViewTarget::new(self, width, height)?;
         self.draw(&mut target, material, scene, mode, samples);
         target.read(self)
     }

@@ -50,7 +50,8 @@ fn far_truth_matches_cpu(r: &Renderer, p: &Evaluator, label: &str) {
             light: DVec3::Z,
             shape: Shape::Plane,
         };
-        let gm = GpuMaterial::new(r.context(), p, camera.target);
+        let gm =
+            GpuMaterial::new(r.context(), p, camera.target).expect("the material fits the adapter");
         let img = r
             .render(&gm, &scene, ViewMode::Truth, (16, 16), 64)
             .expect("readback");
@@ -139,7 +140,8 @@ fn analytic_views_match_core_pixel_by_pixel() {
                 light,
                 shape: Shape::Plane,
             };
-            let gm = GpuMaterial::new(r.context(), &p, camera.target);
+            let gm = GpuMaterial::new(r.context(), &p, camera.target)
+                .expect("the material fits the adapter");
             for mode in [
                 ViewMode::Naive,
                 ViewMode::ViewIndependent,
@@ -215,7 +217,8 @@ fn cylinder_views_match_core_for(r: &Renderer, name: &str) {
         light,
         shape: Shape::Cylinder { radius },
     };
-    let gm = GpuMaterial::new(r.context(), &p, camera.target);
+    let gm =
+        GpuMaterial::new(r.context(), &p, camera.target).expect("the material fits the adapter");
     let (w, h) = (48, 36);
     let mut sky = 0;
     for mode in [ViewMode::Naive, ViewMode::Filtered] {
@@ -376,7 +379,8 @@ fn image_driver_views_match_core() {
             light,
             shape: Shape::Plane,
         };
-        let gm = GpuMaterial::new(r.context(), &p, camera.target);
+        let gm = GpuMaterial::new(r.context(), &p, camera.target)
+            .expect("the material fits the adapter");
         for mode in [
             ViewMode::Naive,
             ViewMode::ViewIndependent,
@@ -443,8 +447,10 @@ fn fast_and_reference_marches_render_the_same_images() {
             light: direction(0.9, 2.0),
             shape,
         };
-        let gf = GpuMaterial::new(r.context(), &fast, camera.target);
-        let gr = GpuMaterial::new(r.context(), &reference, camera.target);
+        let gf = GpuMaterial::new(r.context(), &fast, camera.target)
+            .expect("the material fits the adapter");
+        let gr = GpuMaterial::new(r.context(), &reference, camera.target)
+            .expect("the material fits the adapter");
         for mode in [ViewMode::Naive, ViewMode::Filtered, ViewMode::Truth] {
             let a = r.render(&gf, &scene, mode, (w, h), 4).expect("fast");
             let b = r.render(&gr, &scene, mode, (w, h), 4).expect("reference");

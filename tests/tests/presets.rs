@@ -74,7 +74,8 @@ fn every_preset_renders() {
     for (path, text) in presets() {
         let m = Material::from_ron(&text).unwrap();
         let p = prepare(&path, &m);
-        let gm = GpuMaterial::new(r.context(), &p, scene.camera.target);
+        let gm = GpuMaterial::new(r.context(), &p, scene.camera.target)
+            .expect("the material fits the adapter");
         for mode in [
             ViewMode::Naive,
             ViewMode::ViewIndependent,

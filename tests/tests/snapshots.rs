@@ -134,7 +134,8 @@ fn views_match_their_snapshots() {
                 light,
                 shape,
             };
-            let gm = GpuMaterial::new(r.context(), &prepared, camera.target);
+            let gm = GpuMaterial::new(r.context(), &prepared, camera.target)
+                .expect("the material fits the adapter");
             for (mode_name, mode) in [
                 ("naive", ViewMode::Naive),
                 ("view_independent", ViewMode::ViewIndependent),

@@ -60,8 +60,10 @@ fn specialised_pipelines_render_what_the_all_features_pipeline_renders() {
     for (path, text) in presets() {
         let m = Material::from_ron(&text).unwrap_or_else(|e| panic!("{path}: {e}"));
         let prepared = prepare(&path, &m);
-        let special = GpuMaterial::new(r.context(), &prepared, camera.target);
-        let all = GpuMaterial::all_features(r.context(), &prepared, camera.target);
+        let special = GpuMaterial::new(r.context(), &prepared, camera.target)
+            .expect("the material fits the adapter");
+        let all = GpuMaterial::all_features(r.context(), &prepared, camera.target)
+            .expect("the material fits the adapter");
         for (scene_name, shape, light) in scenes {
             let scene = Scene {
                 camera,

@@ -270,10 +270,18 @@ impl State {
                     p.set_environment_radiance(sh);
                 }
                 self.environment = *environment;
-                let gm = GpuMaterial::new(self.renderer.context(), &p, [0.0, 0.0]);
-                self.material = Some((material.clone(), gm));
-                self.prepared = Some(p);
-                true
+                match GpuMaterial::new(self.renderer.context(), &p, [0.0, 0.0]) {
+                    Ok(gm) => {
+                        self.material = Some((material.clone(), gm));
+                        self.prepared = Some(p);
+                        true
+                    }
+                    Err(e) => {
+                        self.material = None;
+                        send(Event::MaterialError(e.to_string()));
+                        false
+                    }
+                }
             }
             Err(e) => {
                 self.material = None;
@@ -391,7 +399,13 @@ impl State {
         let size = Self::size_at(req, scale);
         let mut target = match self.truth.take() {
             Some(t) if t.size() == size => t,
-            _ => ViewTarget::new(&self.renderer, size.0, size.1),
+            _ => match ViewTarget::new(&self.renderer, size.0, size.1) {
+                Ok(t) => t,
+                Err(e) => {
+                    send(Event::RenderError(e.to_string()));
+                    return Ok(None);
+                }
+            },
         };
         target.reset();
         let mut last_sent = Instant::now() - Duration::from_secs(1);
