@@ -93,7 +93,6 @@ const MIRRORS: &[(&str, &str, &str, &str)] = &[
     ("scene/octave_march.wgsl", "octave_height", "scene/octave_march.rs", "march"),
     ("scene/octave_march.wgsl", "octave_step", "scene/octave_march.rs", "step"),
     ("scene/octave_march.wgsl", "octave_grid_gap", "scene/octave_march.rs", "grid_gap"),
-    ("scene/octave_march.wgsl", "octave_converge", "scene/octave_march.rs", "converge"),
     ("scene/octave_march.wgsl", "octave_grid_skip", "scene/octave_march.rs", "grid_skip"),
     ("scene/bound_grid.wgsl", "grid_range", "scene/bound_grid.rs", "range"),
     ("scene/bound_grid.wgsl", "grid_view_range", "scene/bound_grid.rs", "range"),

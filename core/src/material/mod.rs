@@ -438,6 +438,12 @@ mod tests {
             assert!(fields.contains(&f), "{f} missing from {fields:?}");
         }
         assert_eq!(problems.len(), 5);
+        // Tables the GPU could not bind are refused at once, not after minutes of building.
+        let mut big = Material::default();
+        big.filtering.table.size_sigma = 4096;
+        let problems = big.validate().unwrap_err();
+        assert_eq!(problems.len(), 1);
+        assert_eq!(problems[0].field, "filtering.table.size_sigma");
     }
 
     #[test]

@@ -46,8 +46,10 @@ impl Default for TableSpec {
 }
 
 impl TableSpec {
-    /// Largest accepted size per axis (a 4096² RGBA32F table is 256 MiB).
-    pub const MAX_SIZE: usize = 4096;
+    /// Largest accepted size per axis: a 1024² RGBA32F table is 16 MiB, so the colour and transfer
+    /// tables together stay far below the 128 MiB one storage binding holds on the software adapter
+    /// (4096² was 256 MiB each: accepted, minutes to build, then refused by the GPU; issue #16).
+    pub const MAX_SIZE: usize = 1024;
 
     /// Clamp to valid values (2..=MAX_SIZE texels, σ_max > 0 and finite).
     pub fn sanitized(self) -> Self {

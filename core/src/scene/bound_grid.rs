@@ -228,6 +228,7 @@ pub struct GridView<'a> {
     /// On the level-of-detail surface, `D = Σ|a_i|(1 − g_i)` (g_i the footprint attenuations):
     /// `|f̄ − f| ≤ D` everywhere, so f̄ also lies within the undilated box's range widened by D;
     /// the view returns the tighter of the two ranges. Infinite on the explicit surface (unused).
+    /// CPU only: the WGSL skips this second lookup, which cost llvmpipe more than it saved.
     pub shift: f64,
 }
 

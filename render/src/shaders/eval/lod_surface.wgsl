@@ -13,8 +13,6 @@ var<private> lod_count: u32;
 // The footprint's 6σ per axis, by which the octave march dilates the bound grid's boxes
 // (GridView::level_of_detail). Set by lod_prepare.
 var<private> lod_dilate: vec2<f32>;
-// Σ|a_i|(1 − g_i): how far f̄ can be from f (GridView::level_of_detail's shift). Set by lod_prepare.
-var<private> lod_shift: f32;
 
 //#endif
 //#endif
@@ -40,14 +38,12 @@ fn lod_prepare(fp: vec3<f32>) -> f32 {
     var v = 0.0;
 //#if noise
     lod_dilate = 6.0 * sqrt(max(fp.xy, vec2<f32>(0.0)));
-    lod_shift = 0.0;
     lod_count = 0u;
     for (var i = 0u; i < params.wave_count; i = i + 1u) {
         let w = wave(i);
         let q = w.x * w.x * fp.x + 2.0 * w.x * w.y * fp.z + w.y * w.y * fp.y;
         let g = exp(-2.0 * PI * PI * q);
         lod_att[i] = g;
-        lod_shift = lod_shift + abs(w.z) * (1.0 - g);
         v = v + w.z * w.z * (1.0 - g * g) * 0.5;
         if (abs(w.z) * g >= 1e-10) {
             lod_count = i + 1u;

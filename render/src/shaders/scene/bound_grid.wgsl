@@ -49,21 +49,13 @@ fn grid_range(lo: vec2<f32>, hi: vec2<f32>) -> vec3<f32> {
     return vec3<f32>(a, b, 1.0);
 }
 
-// GridView::range: the range over the segment from a to b, its box dilated by `dilate`, widened by
-// `tail`, intersected with the undilated box's range widened by `shift + tail` (shift < 0: explicit
-// surface, no intersection); (0, 0, 0) outside the grid.
-fn grid_view_range(a: vec2<f32>, b: vec2<f32>, dilate: vec2<f32>, tail: f32, shift: f32) -> vec3<f32> {
-    let lo = min(a, b);
-    let hi = max(a, b);
-    var r = grid_range(lo - dilate, hi + dilate);
+// GridView::range without the shifted second lookup (GPU only: on llvmpipe it cost more than it
+// saved): the range over the segment from a to b, its box dilated by `dilate`, widened by `tail`;
+// (0, 0, 0) outside the grid. Looser than core's where core intersects, never tighter: rigorous.
+fn grid_view_range(a: vec2<f32>, b: vec2<f32>, dilate: vec2<f32>, tail: f32) -> vec3<f32> {
+    let r = grid_range(min(a, b) - dilate, max(a, b) + dilate);
     if (r.z == 0.0) {
         return r;
-    }
-    if (shift >= 0.0) {
-        let r2 = grid_range(lo, hi);
-        if (r2.z > 0.0) {
-            r = vec3<f32>(max(r.x, r2.x - shift), min(r.y, r2.y + shift), 1.0);
-        }
     }
     return vec3<f32>(r.x - tail, r.y + tail, 1.0);
 }

@@ -169,65 +169,19 @@ fn octave_local_step(found_in: vec3<f32>, above: f32, f: f32, fd: f32, lip: f32,
     return found;
 }
 
-// OctaveSurface::converge: for the identity transfer near a transversal crossing (β² ≥ 4cγ), the
-// first crossing is the only one in (t, t + s_hi] and the gap decreases strictly there: safeguarded
-// Newton to FAST_WIDTH, returning the last point above; -1 when the conditions do not hold.
-fn octave_converge(o: vec3<f32>, d: vec3<f32>, t: f32, gap: f32, fd: f32, curv: f32, lod: bool, sf: f32) -> f32 {
-    if (params.transfer_kind != TRANSFER_IDENTITY || !(gap > 0.0)) {
-        return -1.0;
-    }
-    let beta = params.sigma_h * fd - d.z;
-    let c = 0.5 * params.sigma_h * curv;
-    let disc = beta * beta - 4.0 * c * gap;
-    if (!(beta > 0.0 && disc >= 0.0)) {
-        return -1.0;
-    }
-    var b = t + 2.0 * gap / (beta + sqrt(disc));
-    let width = FAST_WIDTH * max(abs(b), 1.0);
-    var a = t;
-    var x = t;
-    var gx = gap;
-    var rx = beta;
-    let n = octave_count(lod);
-    for (var i = 0u; i < 64u; i = i + 1u) {
-        if (b - a <= width) {
-            break;
-        }
-        var m = x + gx / rx;
-        if (!(m > a && m < b)) {
-            m = 0.5 * (a + b);
-        }
-        m = clamp(m, a + 0.5 * width, b - 0.5 * width);
-        let q = o + d * m;
-        let fm = octave_partial(0u, n, q.xy, d.xy, lod);
-        let gm = q.z - octave_height(fm.x, lod, sf);
-        if (gm >= 0.0) {
-            a = m;
-        } else {
-            b = m;
-        }
-        x = m;
-        gx = gm;
-        // The gap decreases strictly here: a rate that rounding makes non-positive bisects next.
-        rx = max(params.sigma_h * fm.y - d.z, 1e-30);
-    }
-    return a;
-}
-
 // OctaveSurface::grid_gap: a lower bound of the gap along the segment from a to b from the grid's
 // range of f over its box, as (gap, 1), or (0, 0) outside the grid. On the level-of-detail surface
-// the box is dilated by lod_dilate and the range tightened by lod_shift (GridView::level_of_detail). GPU only: a margin of
+// the box is dilated by lod_dilate (GridView::level_of_detail; GPU only: without core's second,
+// shifted lookup, which cost llvmpipe more than it saved). GPU only: a margin of
 // GRID_MARGIN·Σ|a_i| for the f32 sums (phases near the target are accurate to ~1e-5 rad).
 fn octave_grid_gap(a: vec3<f32>, b: vec3<f32>, lod: bool, sf: f32) -> vec2<f32> {
     var dilate = vec2<f32>(0.0);
     var tail = GRID_MARGIN * params.grid_amp;
-    var shift = -1.0;
     if (lod) {
         dilate = lod_dilate;
         tail = tail + 8e-9 * params.grid_amp;
-        shift = lod_shift;
     }
-    let r = grid_view_range(a.xy, b.xy, dilate, tail, shift);
+    let r = grid_view_range(a.xy, b.xy, dilate, tail);
     if (r.z == 0.0) {
         return vec2<f32>(0.0);
     }
@@ -324,12 +278,6 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
                 }
                 // The origin is on the surface by contract: a negative gap here is rounding.
                 gap = 0.0;
-            }
-            if (l == last && t > 0.0) {
-                let hit = octave_converge(o, d, t, gap, acc.y, rw.curv[l], lod, sf);
-                if (hit >= 0.0) {
-                    return hit;
-                }
             }
             var found = vec3<f32>(0.0);
             if (gap >= 0.0) {
