@@ -50,7 +50,10 @@ fn pcg(v: u32) -> u32 {
 
 
 @compute @workgroup_size(8, 8)
-fn view_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn view_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+//#if noise
+    fill_wave_cache(local, 64u);
+//#endif
     if (gid.x >= view_params.width || gid.y >= view_params.height) {
         return;
     }

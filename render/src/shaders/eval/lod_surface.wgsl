@@ -40,7 +40,7 @@ fn lod_prepare(fp: vec3<f32>) -> f32 {
     lod_dilate = 6.0 * sqrt(max(fp.xy, vec2<f32>(0.0)));
     lod_count = 0u;
     for (var i = 0u; i < params.wave_count; i = i + 1u) {
-        let w = wave(i);
+        let w = cached_wave(i);
         let q = w.x * w.x * fp.x + 2.0 * w.x * w.y * fp.z + w.y * w.y * fp.y;
         let g = exp(-2.0 * PI * PI * q);
         lod_att[i] = g;
@@ -58,7 +58,7 @@ fn lod_prepare(fp: vec3<f32>) -> f32 {
 //#if noise
 // Wave i's term of f̄(x).
 fn lod_term(i: u32, x: vec2<f32>) -> f32 {
-    let w = wave(i);
+    let w = cached_wave(i);
     return w.z * lod_att[i] * cos(TAU * dot(w.xy, x) + w.w);
 }
 
@@ -106,7 +106,7 @@ fn lod_rate(d: vec3<f32>) -> f32 {
 //#endif
 //#if noise
         for (var i = 0u; i < params.wave_count; i = i + 1u) {
-            let w = wave(i);
+            let w = cached_wave(i);
             k = k + abs(w.z) * lod_att[i] * TAU * abs(dot(w.xy, dir));
         }
 //#endif

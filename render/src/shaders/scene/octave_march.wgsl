@@ -16,9 +16,9 @@ struct OctaveRay {
 // the level-of-detail surface.
 fn octave_amplitude(i: u32, lod: bool) -> f32 {
     if (lod) {
-        return wave(i).z * lod_att[i];
+        return cached_wave(i).z * lod_att[i];
     }
-    return wave(i).z;
+    return cached_wave(i).z;
 }
 
 // The waves the march sums: all on the explicit surface; on the level-of-detail surface those before
@@ -57,7 +57,7 @@ fn octave_ray(d: vec3<f32>, lod: bool) -> OctaveRay {
         let e = level_end(l, lod);
         for (var i = start; i < e; i = i + 1u) {
             let a = abs(octave_amplitude(i, lod));
-            let om = TAU * dot(wave(i).xy, d.xy);
+            let om = TAU * dot(cached_wave(i).xy, d.xy);
             k = k + a * abs(om);
             m = m + a * om * om;
             below = below + a;
@@ -74,7 +74,7 @@ fn octave_ray(d: vec3<f32>, lod: bool) -> OctaveRay {
 
 // Wave i's (value, slope along dxy) at x, for OctaveSurface::march's partial sums.
 fn octave_term(i: u32, x: vec2<f32>, dxy: vec2<f32>, lod: bool) -> vec2<f32> {
-    let w = wave(i);
+    let w = cached_wave(i);
     let a = octave_amplitude(i, lod);
     let ph = TAU * dot(w.xy, x) + w.w;
     return vec2<f32>(a * cos(ph), -a * TAU * dot(w.xy, dxy) * sin(ph));
