@@ -130,8 +130,8 @@ pub enum EquirectError {
     /// Size and texel count disagree, or the map is empty.
     #[error("an environment map needs at least 2×1 texels and width·height of them")]
     Size,
-    /// A texel is negative, NaN or infinite.
-    #[error("texel ({x}, {y}) is not a finite non-negative radiance")]
+    /// A texel is negative, NaN, infinite or above [`EquirectMap::MAX_RADIANCE`].
+    #[error("texel ({x}, {y}) is not a radiance between 0 and 1e9")]
     NotFinite {
         /// Column.
         x: usize,
@@ -141,14 +141,19 @@ pub enum EquirectError {
 }
 
 impl EquirectMap {
-    /// Check and wrap texels.
+    /// Largest texel radiance accepted: far above a captured sun (~1e5 in HDR maps), far below
+    /// where f32 sums on the GPU overflow (#16: texels of 3e38 turned the filtered view black and
+    /// the error report into "RMSE NaN, max 0").
+    pub const MAX_RADIANCE: f32 = 1e9;
+
+    /// Check and wrap texels: each finite, non-negative and at most [`Self::MAX_RADIANCE`].
     pub fn new(width: usize, height: usize, texels: Vec<[f32; 3]>) -> Result<Self, EquirectError> {
         if width < 2 || height < 1 || texels.len() != width * height {
             return Err(EquirectError::Size);
         }
         if let Some(i) = texels
             .iter()
-            .position(|t| t.iter().any(|v| !v.is_finite() || *v < 0.0))
+            .position(|t| t.iter().any(|v| !(0.0..=Self::MAX_RADIANCE).contains(v)))
         {
             return Err(EquirectError::NotFinite {
                 x: i % width,
@@ -175,6 +180,7 @@ impl EquirectMap {
 
 /// Where the environment's radiance comes from.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum EnvironmentSource {
     /// The built-in procedural sky (no file needed).
     Sky(Sky),
@@ -304,6 +310,19 @@ mod tests {
             EquirectMap::new(4, 2, t),
             Err(EquirectError::NotFinite { x: 1, y: 1 })
         );
+        // Finite but beyond what f32 sums survive (3e38), and negative.
+        for v in [3e38, EquirectMap::MAX_RADIANCE * 1.01, -1e-3] {
+            let mut t = vec![[0.5; 3]; 8];
+            t[6][2] = v;
+            assert_eq!(
+                EquirectMap::new(4, 2, t),
+                Err(EquirectError::NotFinite { x: 2, y: 1 }),
+                "{v}"
+            );
+        }
+        let mut t = vec![[0.5; 3]; 8];
+        t[6][2] = EquirectMap::MAX_RADIANCE;
+        assert!(EquirectMap::new(4, 2, t).is_ok());
     }
 
     #[test]

@@ -38,11 +38,18 @@ use serde::{Deserialize, Serialize};
 /// Current preset format version.
 pub const MATERIAL_VERSION: u32 = 1;
 
-/// Upper bound of σ_h, σ_n and roughness accepted from a preset (the UI range).
+/// Upper bound of σ_h and roughness accepted from a preset.
 pub const MAX_SIGMA: f64 = 1e6;
+
+/// Upper bound of σ_nx and σ_ny accepted from a preset: a slope standard deviation of 10 (84°; the
+/// editor's sliders end at 2). The noise's wave numbers scale with σ_n/σ_h, so a ray's march steps
+/// scale with σ_n: at 1e6 `eval` marched for minutes and returned a ground truth of 0 (#16). The
+/// formulas themselves stay finite far beyond (`lodestone stability` runs σ_n = 1e6 directly).
+pub const MAX_SLOPE_SIGMA: f64 = 10.0;
 
 /// The driving function f.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Driver {
     /// Sum-of-sinusoids noise with analytic footprint statistics.
     Noise(NoiseParams),
@@ -67,6 +74,7 @@ pub enum ColorSource {
 
 /// How the surface is coloured.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum ColorModel {
     /// A gradient colour map [HNPN14 Secs. 4, 5.1].
     Gradient {
@@ -297,8 +305,18 @@ impl Material {
         if let TransferFunction::Curve(c) = &self.heights.transfer {
             c.validate("heights.transfer", &mut p);
         }
-        p.in_range("slopes.sigma_nx", self.slopes.sigma_nx, 0.0, MAX_SIGMA);
-        p.in_range("slopes.sigma_ny", self.slopes.sigma_ny, 0.0, MAX_SIGMA);
+        p.in_range(
+            "slopes.sigma_nx",
+            self.slopes.sigma_nx,
+            0.0,
+            MAX_SLOPE_SIGMA,
+        );
+        p.in_range(
+            "slopes.sigma_ny",
+            self.slopes.sigma_ny,
+            0.0,
+            MAX_SLOPE_SIGMA,
+        );
         match &self.color {
             ColorModel::Gradient { map, .. } => map.validate("color.map", &mut p),
             ColorModel::Attribute { mean, correlation } => {
@@ -392,6 +410,66 @@ mod tests {
         ));
     }
 
+    /// Unknown fields inside enum variants are refused like those of structs (#16: a `sorce:` typo
+    /// in a Gradient was dropped, silently changing the colour source). Each case parses without
+    /// its unknown field.
+    #[test]
+    fn unknown_fields_inside_enum_variants_are_parse_errors() {
+        let base = r#"Material(version: 1, name: "a", driver: DRIVER, heights: (sigma_h: 0.05),
+            slopes: (sigma_nx: 0.3, sigma_ny: 0.3), color: COLOR, LIGHTING
+            brdf: (albedo: 1.0, specular: 0.04, roughness: 0.2))"#;
+        let noise = "Noise(())";
+        let attribute = "Attribute(mean: (0.3, 0.3, 0.3), correlation: (0.1, 0.1, 0.1)EXTRA)";
+        let gradient =
+            "Gradient(map: (stops: [(position: 0.0, color: (0.5, 0.5, 0.5))]), source: Height)";
+        let text = |driver: &str, color: &str, lighting: &str| {
+            base.replace("DRIVER", driver)
+                .replace("COLOR", color)
+                .replace("LIGHTING", lighting)
+        };
+        let file = "lighting: (environment: Some((source: File(path: \"sky.exr\"EXTRA)))),";
+        let cases = [
+            (
+                "Attribute(colour:)",
+                text(noise, attribute, ""),
+                ", colour: 1.0",
+            ),
+            (
+                "Image(sise:)",
+                text(
+                    "Image(path: \"x.png\", size: 1.0EXTRA)",
+                    &attribute.replace("EXTRA", ""),
+                    "",
+                ),
+                ", sise: 2.0",
+            ),
+            (
+                "File(pth:)",
+                text(noise, &attribute.replace("EXTRA", ""), file),
+                ", pth: 1",
+            ),
+            (
+                "Gradient(sorce:)",
+                text(noise, &gradient.replace("source", "EXTRAsource"), ""),
+                "sorce: Driver, ",
+            ),
+        ];
+        for (what, template, extra) in cases {
+            let good = template.replace("EXTRA", "");
+            assert!(
+                Material::from_ron(&good).is_ok(),
+                "{what} without the field: {:?}",
+                Material::from_ron(&good)
+            );
+            match Material::from_ron(&template.replace("EXTRA", extra)) {
+                Err(MaterialError::Parse { line, message, .. }) => {
+                    assert!(line >= 1 && message.contains("field"), "{what}: {message}")
+                }
+                other => panic!("{what}: expected a parse error, got {other:?}"),
+            }
+        }
+    }
+
     #[test]
     fn newer_versions_are_refused() {
         let text = Material::default()
@@ -444,6 +522,42 @@ mod tests {
         let problems = big.validate().unwrap_err();
         assert_eq!(problems.len(), 1);
         assert_eq!(problems[0].field, "filtering.table.size_sigma");
+        // Work that grows with the input is bounded: stops, curve points, slopes (#16).
+        let mut many = Material {
+            color: ColorModel::Gradient {
+                map: Gradient {
+                    stops: (0..=Gradient::MAX_STOPS)
+                        .map(|i| ColorStop {
+                            position: i as f64,
+                            color: [0.5; 3],
+                        })
+                        .collect(),
+                    interpolation: Interpolation::Linear,
+                },
+                source: ColorSource::Driver,
+            },
+            ..Material::default()
+        };
+        many.heights.transfer = TransferFunction::Curve(crate::material::transfer::Curve {
+            points: (0..=crate::material::transfer::Curve::MAX_POINTS)
+                .map(|i| [i as f64 * 0.01, i as f64 * 0.01])
+                .collect(),
+            interpolation: crate::material::transfer::CurveInterpolation::Linear,
+        });
+        many.slopes.sigma_ny = MAX_SLOPE_SIGMA * 1.01;
+        let problems = many.validate().unwrap_err();
+        let fields: Vec<_> = problems.iter().map(|p| p.field.as_str()).collect();
+        assert_eq!(
+            fields,
+            [
+                "heights.transfer.points",
+                "slopes.sigma_ny",
+                "color.map.stops"
+            ],
+            "{problems:?}"
+        );
+        many.slopes.sigma_ny = MAX_SLOPE_SIGMA;
+        assert_eq!(many.validate().unwrap_err().len(), 2);
     }
 
     #[test]

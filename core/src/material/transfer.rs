@@ -250,7 +250,11 @@ impl Curve {
     /// Smallest non-zero distance in f between successive points.
     pub const MIN_GAP: f64 = 1e-6;
 
-    /// Record every problem: fewer than two points, values beyond ±[`Self::MAX_F`] / ±[`Self::MAX_G`]
+    /// Most points a curve may have: each is a polynomial piece the pre-convolved tables integrate
+    /// per texel (#16: a 400 000-point curve never finished).
+    pub const MAX_POINTS: usize = 256;
+
+    /// Record every problem: fewer than two points or more than [`Self::MAX_POINTS`], values beyond ±[`Self::MAX_F`] / ±[`Self::MAX_G`]
     /// (or not finite), unsorted f.
     pub fn validate(&self, field: &str, problems: &mut Problems) {
         if self.points.len() < 2 {
@@ -258,6 +262,17 @@ impl Curve {
                 format!("{field}.points"),
                 "a transfer curve needs at least two points",
             );
+        }
+        if self.points.len() > Self::MAX_POINTS {
+            problems.push(
+                format!("{field}.points"),
+                format!(
+                    "a transfer curve has at most {} points, got {}",
+                    Self::MAX_POINTS,
+                    self.points.len()
+                ),
+            );
+            return;
         }
         for (i, p) in self.points.iter().enumerate() {
             problems.in_range(

@@ -4,6 +4,7 @@ use serde::{Deserialize, Serialize};
 
 /// Which object the views show.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
 pub enum Shape {
     /// The unbounded plane z = 0.
     #[default]
