@@ -23,19 +23,19 @@ pub enum Command {
     /// filtering, the filtered model and ray-traced ground truth (CPU reference evaluator).
     Eval {
         /// View angle from the normal, degrees (0 to 89.5).
-        #[arg(long, default_value_t = 0.0)]
+        #[arg(long, default_value_t = 0.0, value_parser = view_angle)]
         view_deg: f64,
         /// View azimuth, degrees.
-        #[arg(long, default_value_t = 0.0)]
+        #[arg(long, default_value_t = 0.0, value_parser = azimuth)]
         view_azimuth_deg: f64,
-        /// Light angle from the normal, degrees.
-        #[arg(long, default_value_t = 0.0)]
+        /// Light angle from the normal, degrees (0 to 180; past 90 the sun is below the horizon).
+        #[arg(long, default_value_t = 0.0, value_parser = light_angle)]
         light_deg: f64,
         /// Light azimuth, degrees.
-        #[arg(long, default_value_t = 0.0)]
+        #[arg(long, default_value_t = 0.0, value_parser = azimuth)]
         light_azimuth_deg: f64,
-        /// Ground-truth samples (eye rays) for the patch.
-        #[arg(long, default_value_t = 40_000)]
+        /// Ground-truth samples (eye rays) for the patch (2 to 10⁸: its standard error needs two).
+        #[arg(long, default_value_t = 40_000, value_parser = eval_samples)]
         spp: usize,
         /// Print JSON instead of a table.
         #[arg(long)]
@@ -47,19 +47,20 @@ pub enum Command {
         #[arg(long, value_enum, default_value_t = RenderMode::All)]
         mode: RenderMode,
         /// Camera angle from the normal, degrees (0 to 89.5).
-        #[arg(long, default_value_t = 60.0)]
+        #[arg(long, default_value_t = 60.0, value_parser = view_angle)]
         view_deg: f64,
         /// Camera azimuth, degrees.
-        #[arg(long, default_value_t = 0.0)]
+        #[arg(long, default_value_t = 0.0, value_parser = azimuth)]
         view_azimuth_deg: f64,
-        /// Light angle from the normal, degrees.
-        #[arg(long, default_value_t = 30.0)]
+        /// Light angle from the normal, degrees (0 to 180; past 90 the sun is below the horizon).
+        #[arg(long, default_value_t = 30.0, value_parser = light_angle)]
         light_deg: f64,
         /// Light azimuth, degrees.
-        #[arg(long, default_value_t = 90.0)]
+        #[arg(long, default_value_t = 90.0, value_parser = azimuth)]
         light_azimuth_deg: f64,
-        /// Camera distance to its target (world units); features are about 1 unit across.
-        #[arg(long, default_value_t = 6.0)]
+        /// Camera distance to its target (world units, 0.02 to 5000, as in the editor); features
+        /// are about 1 unit across.
+        #[arg(long, default_value_t = 6.0, value_parser = distance)]
         distance: f64,
         /// Image size, WxH.
         #[arg(long, default_value = "512x384", value_parser = parse_size)]
@@ -67,11 +68,11 @@ pub enum Command {
         /// The object: the plane, or a cylinder whose top line passes through the camera target.
         #[arg(long, value_enum, default_value_t = ShapeArg::Plane)]
         shape: ShapeArg,
-        /// Radius of the cylinder (world units).
-        #[arg(long, default_value_t = 2.0)]
+        /// Radius of the cylinder (world units, 0.01 to 10⁴).
+        #[arg(long, default_value_t = 2.0, value_parser = radius)]
         radius: f64,
-        /// Ground-truth rays per pixel.
-        #[arg(long, default_value_t = 64)]
+        /// Ground-truth rays per pixel (1 to 65536).
+        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65536))]
         spp: u32,
         /// Output: a .png or .exr file, or a directory for `--mode all`.
         #[arg(long)]
@@ -90,18 +91,18 @@ pub enum Command {
         /// Image size, WxH.
         #[arg(long, default_value = "512x512", value_parser = parse_size)]
         size: (u32, u32),
-        /// Camera angles from the normal to sweep, degrees (comma-separated).
-        #[arg(long, default_value = "60", value_delimiter = ',')]
+        /// Camera angles from the normal to sweep, degrees (comma-separated, each 0 to 89.5).
+        #[arg(long, default_value = "60", value_delimiter = ',', value_parser = view_angle)]
         view_deg: Vec<f64>,
-        /// Camera distances to sweep, world units (comma-separated).
-        #[arg(long, default_value = "6", value_delimiter = ',')]
+        /// Camera distances to sweep, world units (comma-separated, each 0.02 to 5000).
+        #[arg(long, default_value = "6", value_delimiter = ',', value_parser = distance)]
         distance: Vec<f64>,
         /// Presets to sweep (comma-separated RON files); the global --preset (or the built-in
         /// default) when omitted.
         #[arg(long, value_delimiter = ',')]
         presets: Vec<PathBuf>,
-        /// Timed frames per mode (after one warm-up frame).
-        #[arg(long, default_value_t = 5)]
+        /// Timed frames per mode (after one warm-up frame; 1 to 1000).
+        #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
         frames: u32,
         /// Print JSON.
         #[arg(long)]
@@ -121,11 +122,11 @@ pub enum Command {
         /// Print JSON.
         #[arg(long)]
         json: bool,
-        /// Light angle from the normal, degrees (0 puts it at the normal: no shadow rays).
-        #[arg(long, default_value_t = 30.0)]
+        /// Light angle from the normal, degrees (0 puts it at the normal: no shadow rays; 0 to 180).
+        #[arg(long, default_value_t = 30.0, value_parser = light_angle)]
         light_deg: f64,
         /// Light azimuth, degrees.
-        #[arg(long, default_value_t = 90.0)]
+        #[arg(long, default_value_t = 90.0, value_parser = azimuth)]
         light_azimuth_deg: f64,
         /// The object: the plane, or a cylinder of radius 2.
         #[arg(long, value_enum, default_value_t = ShapeArg::Plane)]
@@ -136,8 +137,8 @@ pub enum Command {
         /// Image size for --time, WxH.
         #[arg(long, default_value = "256x192", value_parser = parse_size)]
         size: (u32, u32),
-        /// Timed batches of 8 frames per mode for --time.
-        #[arg(long, default_value_t = 5)]
+        /// Timed batches of 8 frames per mode for --time (1 to 1000).
+        #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
         frames: u32,
     },
     /// Parse and validate a preset; exit code 2 and every problem on failure.
@@ -156,17 +157,17 @@ pub enum Command {
         /// Image size WIDTHxHEIGHT of every rendering.
         #[arg(long, default_value = "64x40", value_parser = parse_size)]
         size: (u32, u32),
-        /// Rays per pixel of the reference.
-        #[arg(long, default_value_t = 1024)]
+        /// Rays per pixel of the reference (1 to 65536).
+        #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=65536))]
         reference_spp: u32,
-        /// View angles from the normal, degrees (comma-separated).
-        #[arg(long, default_value = "0,30,60,75,85,89", value_delimiter = ',')]
+        /// View angles from the normal, degrees (comma-separated, each 0 to 89.5).
+        #[arg(long, default_value = "0,30,60,75,85,89", value_delimiter = ',', value_parser = view_angle)]
         views: Vec<f64>,
-        /// Camera distances, one per zoom level (comma-separated).
-        #[arg(long, default_value = "1.5,6,40", value_delimiter = ',')]
+        /// Camera distances, one per zoom level (comma-separated, each 0.02 to 5000).
+        #[arg(long, default_value = "1.5,6,40", value_delimiter = ',', value_parser = distance)]
         zooms: Vec<f64>,
-        /// Timing repeats (the median is reported).
-        #[arg(long, default_value_t = 5)]
+        /// Timing repeats (the median is reported; 1 to 1000).
+        #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
         repeats: u32,
         /// How the ray marches step and refine a crossing (the reference stays selectable).
         #[arg(long, value_enum, default_value_t = MarchArg::Fast)]
@@ -238,6 +239,64 @@ impl ShapeArg {
             ShapeArg::Cylinder => Err(format!("--radius must be a positive number, got {radius}")),
         }
     }
+}
+
+/// A finite number in `[lo, hi]` named `what`, or a message that gives the range and what was
+/// typed (NaN and infinities are refused: they used to become black images or "0.00%" errors).
+fn number_in(s: &str, lo: f64, hi: f64, what: &str) -> Result<f64, String> {
+    let v: f64 = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("{what} must be a number, got {s:?}"))?;
+    if !(lo..=hi).contains(&v) {
+        return Err(format!("{what} must be between {lo} and {hi}, got {s}"));
+    }
+    Ok(v)
+}
+
+/// A camera angle from the normal: 0 to [`Camera::MAX_ELEVATION_DEG`] (89.5) degrees.
+///
+/// [`Camera::MAX_ELEVATION_DEG`]: lodestone_core::scene::camera::Camera::MAX_ELEVATION_DEG
+pub fn view_angle(s: &str) -> Result<f64, String> {
+    let max = lodestone_core::scene::camera::Camera::MAX_ELEVATION_DEG;
+    number_in(s, 0.0, max, "the view angle (degrees from the normal)")
+}
+
+/// A light angle from the normal: 0 to 180 degrees (past 90 the sun is below the horizon).
+pub fn light_angle(s: &str) -> Result<f64, String> {
+    number_in(s, 0.0, 180.0, "the light angle (degrees from the normal)")
+}
+
+/// An azimuth: any finite angle up to ±3600 degrees.
+pub fn azimuth(s: &str) -> Result<f64, String> {
+    number_in(s, -3600.0, 3600.0, "the azimuth (degrees)")
+}
+
+/// A camera distance in the editor's range ([`DISTANCE_RANGE`]).
+///
+/// [`DISTANCE_RANGE`]: crate::editor::view_state::DISTANCE_RANGE
+pub fn distance(s: &str) -> Result<f64, String> {
+    let (lo, hi) = crate::editor::view_state::DISTANCE_RANGE;
+    number_in(s, lo, hi, "the camera distance (world units)")
+}
+
+/// A cylinder radius: 0.01 to 10⁴ world units.
+pub fn radius(s: &str) -> Result<f64, String> {
+    number_in(s, 0.01, 1e4, "the cylinder radius (world units)")
+}
+
+/// `eval`'s ground-truth sample count: 2 (a standard error needs two) to 10⁸.
+pub fn eval_samples(s: &str) -> Result<usize, String> {
+    let v: usize = s
+        .trim()
+        .parse()
+        .map_err(|_| format!("the sample count must be a whole number, got {s:?}"))?;
+    if !(2..=100_000_000).contains(&v) {
+        return Err(format!(
+            "the sample count must be between 2 and 100000000, got {s}"
+        ));
+    }
+    Ok(v)
 }
 
 /// Parse "WxH".

@@ -65,6 +65,48 @@ fn main() -> ExitCode {
 
 /// 2 for bad presets and sizes or materials beyond the adapter's limits, 3 for a missing adapter,
 /// else 1.
+/// A command-line argument that cannot work, found before any work starts (exit code 2).
+#[derive(Debug, thiserror::Error)]
+#[error("{0}")]
+pub struct UsageError(pub String);
+
+/// Where `render` or `report` would write, checked before rendering (#16: a `.txt` output or an
+/// existing file in the way used to fail only after minutes of work): a single image needs a `.png`
+/// or `.exr` name in an existing folder; a folder output must not be an existing file.
+fn check_output(out: &Path, folder: bool) -> Result<(), UsageError> {
+    if folder {
+        if out.exists() && !out.is_dir() {
+            return Err(UsageError(format!(
+                "--out {}: exists and is not a folder",
+                out.display()
+            )));
+        }
+        return Ok(());
+    }
+    let ext = out
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
+    if ext != "png" && ext != "exr" {
+        return Err(UsageError(format!(
+            "--out {}: unsupported output (use .png or .exr)",
+            out.display()
+        )));
+    }
+    if out.is_dir() {
+        return Err(UsageError(format!("--out {}: is a folder", out.display())));
+    }
+    match out.parent() {
+        Some(dir) if !dir.as_os_str().is_empty() && !dir.is_dir() => Err(UsageError(format!(
+            "--out {}: the folder {} does not exist",
+            out.display(),
+            dir.display()
+        ))),
+        _ => Ok(()),
+    }
+}
+
 fn exit_code(e: &anyhow::Error) -> u8 {
     let too_large = |c: &(dyn std::error::Error + 'static)| {
         matches!(
@@ -72,9 +114,12 @@ fn exit_code(e: &anyhow::Error) -> u8 {
             Some(lodestone_render::renderer::RenderError::TooLarge { .. })
         )
     };
-    if e.chain()
-        .any(|c| c.is::<MaterialError>() || c.is::<preset_io::PresetError>() || too_large(c))
-    {
+    if e.chain().any(|c| {
+        c.is::<MaterialError>()
+            || c.is::<preset_io::PresetError>()
+            || c.is::<UsageError>()
+            || too_large(c)
+    }) {
         2
     } else if e.chain().any(|c| c.is::<lodestone_render::GpuError>()) {
         3
@@ -154,7 +199,8 @@ fn run(cli: Cli) -> Result<()> {
             formats,
             march,
         }) => {
-            let shape = shape.shape(radius).map_err(anyhow::Error::msg)?;
+            let shape = shape.shape(radius).map_err(UsageError)?;
+            check_output(&out, mode == cli::RenderMode::All)?;
             let view = render_cmd::View {
                 view_deg,
                 view_azimuth_deg,
@@ -195,7 +241,7 @@ fn run(cli: Cli) -> Result<()> {
             render_cmd::bench(&sweep, &cfg, json)?
         }
         Some(Command::Export { out }) => {
-            let written = preset_io::export_bundle(&preset, &out)?;
+            let written = preset_io::export_bundle(&preset, cli.preset.as_deref(), &out)?;
             outln!(
                 "wrote {} files to {} (see manifest.json)",
                 written.len(),
@@ -245,6 +291,7 @@ fn run(cli: Cli) -> Result<()> {
             repeats,
             march,
         }) => {
+            check_output(&out, true)?;
             let opts = report::Options {
                 size,
                 reference_spp,

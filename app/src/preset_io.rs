@@ -108,9 +108,60 @@ impl Resolved {
     }
 }
 
+/// Largest preset file read (the largest valid preset, 1024 stops and curve points, is under 200 KB).
+pub const MAX_PRESET_BYTES: u64 = 16 << 20;
+
+/// Largest driver image or environment file read (an 8192² RGBA f32 EXR, uncompressed, is 1 GiB).
+pub const MAX_IMAGE_FILE_BYTES: u64 = 1 << 30;
+
+/// Refuse, before opening it, anything but a regular file of at most `max` bytes: opening a FIFO
+/// blocks until a writer comes, and a device such as `/dev/zero` never ends (#16: both used to hang
+/// or grow to gigabytes). Symbolic links are followed.
+pub fn check_regular_file(path: &Path, max: u64) -> std::io::Result<()> {
+    use std::io::{Error, ErrorKind};
+    let meta = std::fs::metadata(path)?;
+    if meta.is_dir() {
+        return Err(Error::new(
+            ErrorKind::InvalidInput,
+            "is a directory, not a file",
+        ));
+    }
+    if !meta.is_file() {
+        return Err(Error::new(
+            ErrorKind::InvalidInput,
+            "is not a regular file (a pipe, socket or device); Lodestone reads only regular files",
+        ));
+    }
+    if meta.len() > max {
+        return Err(Error::new(
+            ErrorKind::InvalidInput,
+            format!("is {} bytes, more than the {max}-byte limit", meta.len()),
+        ));
+    }
+    Ok(())
+}
+
+/// The text of a regular file of at most `max` bytes ([`check_regular_file`]; a file that grows
+/// while it is read is cut at `max + 1` bytes and refused).
+pub fn read_text_capped(path: &Path, max: u64) -> std::io::Result<String> {
+    use std::io::Read;
+    check_regular_file(path, max)?;
+    let mut text = String::new();
+    std::fs::File::open(path)?
+        .take(max + 1)
+        .read_to_string(&mut text)?;
+    if text.len() as u64 > max {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("grew past the {max}-byte limit while being read"),
+        ));
+    }
+    Ok(text)
+}
+
 /// Load a preset and, for an image driver, its image (resolved against the preset's folder).
 pub fn load_resolved(path: &Path) -> Result<Resolved, PresetError> {
-    let text = std::fs::read_to_string(path).map_err(|error| PresetError::Read {
+    let text = read_text_capped(path, MAX_PRESET_BYTES).map_err(|error| PresetError::Read {
         path: path.to_owned(),
         error,
     })?;
@@ -155,6 +206,7 @@ pub fn load_environment(preset: &Path, file: &Path) -> Result<Sh9, PresetError> 
         file: file.to_owned(),
         reason,
     };
+    check_regular_file(file, MAX_IMAGE_FILE_BYTES).map_err(|e| err(e.to_string()))?;
     let (w, h) = image::image_dimensions(file).map_err(|e| err(e.to_string()))?;
     if w > MAX_ENVIRONMENT_SIDE || h > MAX_ENVIRONMENT_SIDE {
         return Err(err(format!(
@@ -193,6 +245,7 @@ pub fn load_image_driver(preset: &Path, image: &Path) -> Result<ImageDriver, Pre
         image: image.to_owned(),
         reason,
     };
+    check_regular_file(image, MAX_IMAGE_FILE_BYTES).map_err(|e| err(e.to_string()))?;
     let (w, h) = image::image_dimensions(image).map_err(|e| err(e.to_string()))?;
     let max = ImageDriver::MAX_SIDE as u32;
     if w > max || h > max {
@@ -204,27 +257,53 @@ pub fn load_image_driver(preset: &Path, image: &Path) -> Result<ImageDriver, Pre
     ImageDriver::new(w as usize, h as usize, img.as_raw()).map_err(|e| err(e.to_string()))
 }
 
-/// Write `text` to `path` atomically (temporary file in the same directory, fsync, rename).
+/// Write `text` to `path` atomically: a temporary file in the same folder, flushed to disk, given
+/// the old file's permissions, renamed over the target, then the folder flushed so the rename
+/// itself survives a power cut. A symbolic link is kept: its target is replaced. Temporary files
+/// that an earlier, crashed save of the same target left behind are removed.
 pub fn write_atomic(path: &Path, text: &str) -> Result<(), PresetError> {
+    write_atomic_with(path, text, |_| Ok(()))
+}
+
+/// [`write_atomic`] with `before_rename` run on the written temporary file just before the rename
+/// (tests interrupt a save there).
+fn write_atomic_with(
+    path: &Path,
+    text: &str,
+    before_rename: impl FnOnce(&Path) -> std::io::Result<()>,
+) -> Result<(), PresetError> {
     let err = |error| PresetError::Write {
         path: path.to_owned(),
         error,
     };
-    let dir = match path.parent() {
+    // Through a symbolic link (chains too) to the file it names.
+    let target = match std::fs::symlink_metadata(path) {
+        Ok(m) if m.file_type().is_symlink() => std::fs::canonicalize(path).map_err(err)?,
+        _ => path.to_owned(),
+    };
+    let dir = match target.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_owned(),
         _ => PathBuf::from("."),
     };
-    let name = path
+    let name = target
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_else(|| "preset".into());
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    let prefix = format!(".{name}.");
+    remove_stale_temps(&dir, &prefix);
+    let tmp = dir.join(format!("{prefix}{}.tmp", std::process::id()));
+    let old = std::fs::metadata(&target).ok();
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(text.as_bytes())?;
+        if let Some(m) = &old {
+            f.set_permissions(m.permissions())?;
+        }
         f.sync_all()?;
         drop(f);
-        std::fs::rename(&tmp, path)
+        before_rename(&tmp)?;
+        std::fs::rename(&tmp, &target)?;
+        sync_dir(&dir)
     })();
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
@@ -232,19 +311,173 @@ pub fn write_atomic(path: &Path, text: &str) -> Result<(), PresetError> {
     result.map_err(err)
 }
 
+/// Remove `dir/{prefix}{pid}.tmp` files of other processes (saves that crashed before their rename).
+fn remove_stale_temps(dir: &Path, prefix: &str) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let ours = format!("{prefix}{}.tmp", std::process::id());
+    for e in entries.flatten() {
+        let n = e.file_name().to_string_lossy().into_owned();
+        let stale = n
+            .strip_prefix(prefix)
+            .and_then(|r| r.strip_suffix(".tmp"))
+            .is_some_and(|pid| !pid.is_empty() && pid.bytes().all(|b| b.is_ascii_digit()));
+        if stale && n != ours {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+/// Flush a folder's entries (the rename) to disk; a no-op where folders cannot be opened (Windows).
+fn sync_dir(dir: &Path) -> std::io::Result<()> {
+    #[cfg(unix)]
+    {
+        std::fs::File::open(dir)?.sync_all()
+    }
+    #[cfg(not(unix))]
+    {
+        let _ = dir;
+        Ok(())
+    }
+}
+
 /// Write the engine bundle of `m` into `dir` (created if needed); returns the files written.
-pub fn export_bundle(m: &Resolved, dir: &Path) -> anyhow::Result<Vec<PathBuf>> {
+///
+/// The files a preset names (a driver image, an environment file), resolved against the folder of
+/// `preset` (the current folder without one), are copied beside it and the bundle's `material.ron`
+/// names the copies, so the bundle reopens anywhere. Every file is first written to a temporary
+/// name in `dir` and flushed; only then are they renamed into place, `manifest.json` last, so an
+/// interrupted export leaves the previous bundle (plus temporaries the next export removes), never
+/// a mix of new and old files.
+pub fn export_bundle(
+    m: &Resolved,
+    preset: Option<&Path>,
+    dir: &Path,
+) -> anyhow::Result<Vec<PathBuf>> {
     use anyhow::Context;
     let prepared = m.prepare()?;
-    let files = lodestone_render::export::bundle(&prepared)?;
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let mut written = Vec::new();
-    for (name, bytes) in files {
-        let p = dir.join(name);
-        std::fs::write(&p, bytes).with_context(|| format!("writing {}", p.display()))?;
-        written.push(p);
+    let mut files = lodestone_render::export::bundle(&prepared)?;
+    let (material, copies) = bundled_material(&m.material, preset)?;
+    for (name, bytes) in &mut files {
+        if name == "material.ron" {
+            *bytes = material.to_ron().into_bytes();
+        }
     }
-    Ok(written)
+    for (name, from) in copies {
+        let bytes = std::fs::read(&from).with_context(|| format!("reading {}", from.display()))?;
+        files.push((name, bytes));
+    }
+    // The manifest goes last: a bundle with a manifest is complete.
+    files.sort_by_key(|(name, _)| name == "manifest.json");
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let staged: Vec<(PathBuf, PathBuf)> = files
+        .iter()
+        .map(|(name, _)| {
+            let prefix = format!(".{name}.");
+            remove_stale_temps(dir, &prefix);
+            (
+                dir.join(format!("{prefix}{}.tmp", std::process::id())),
+                dir.join(name),
+            )
+        })
+        .collect();
+    let result = (|| -> anyhow::Result<()> {
+        for ((tmp, _), (_, bytes)) in staged.iter().zip(&files) {
+            let mut f =
+                std::fs::File::create(tmp).with_context(|| format!("writing {}", tmp.display()))?;
+            f.write_all(bytes)
+                .and_then(|()| f.sync_all())
+                .with_context(|| format!("writing {}", tmp.display()))?;
+        }
+        for (tmp, to) in &staged {
+            std::fs::rename(tmp, to).with_context(|| format!("writing {}", to.display()))?;
+        }
+        sync_dir(dir).with_context(|| format!("flushing {}", dir.display()))
+    })();
+    if result.is_err() {
+        for (tmp, _) in &staged {
+            let _ = std::fs::remove_file(tmp);
+        }
+    }
+    result?;
+    Ok(staged.into_iter().map(|(_, to)| to).collect())
+}
+
+/// The material as a bundle stores it, with the files it names renamed to their bare file names,
+/// and those files (bundle name, source path resolved against `preset`'s folder).
+fn bundled_material(
+    m: &Material,
+    preset: Option<&Path>,
+) -> Result<(Material, Vec<(String, PathBuf)>), PresetError> {
+    let dir = preset.and_then(|p| p.parent()).unwrap_or(Path::new("."));
+    let preset_name = preset.unwrap_or(Path::new("(unsaved material)"));
+    let mut out = m.clone();
+    let mut copies = Vec::new();
+    let mut bundle = |path: &mut String, prefix: &str| -> Result<(), PresetError> {
+        let from = dir.join(&*path);
+        let file = from
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        check_regular_file(&from, MAX_IMAGE_FILE_BYTES).map_err(|e| PresetError::Image {
+            preset: preset_name.to_owned(),
+            image: from.clone(),
+            reason: e.to_string(),
+        })?;
+        // The driver image and the environment keep distinct names even when theirs agree.
+        let name = format!("{prefix}{file}");
+        *path = name.clone();
+        copies.push((name, from));
+        Ok(())
+    };
+    if let Driver::Image { path, .. } = &mut out.driver {
+        bundle(path, "driver-")?;
+    }
+    if let Some(Environment {
+        source: EnvironmentSource::File { path },
+        ..
+    }) = &mut out.lighting.environment
+    {
+        bundle(path, "environment-")?;
+    }
+    Ok((out, copies))
+}
+
+/// `m`, whose file paths are relative to the folder of `from` (the current folder without one),
+/// with those paths rewritten to name the same files from the folder of `to`: relative where the
+/// file lies inside that folder, absolute otherwise. Absolute paths stay. (Saving a preset into
+/// another folder used to keep paths that no longer resolved, #16.)
+pub fn relocate(m: &Material, from: Option<&Path>, to: &Path) -> Material {
+    let from_dir = from.and_then(|p| p.parent()).unwrap_or(Path::new("."));
+    let to_dir = to.parent().unwrap_or(Path::new("."));
+    let absolute = |d: &Path| std::path::absolute(d).unwrap_or_else(|_| d.to_owned());
+    let (from_dir, to_dir) = (absolute(from_dir), absolute(to_dir));
+    let mut out = m.clone();
+    let fix = |path: &mut String| {
+        let p = Path::new(path.as_str());
+        if p.is_absolute() || from_dir == to_dir {
+            return;
+        }
+        let file = from_dir.join(p);
+        let file = std::fs::canonicalize(&file).unwrap_or(file);
+        let to_dir = std::fs::canonicalize(&to_dir).unwrap_or_else(|_| to_dir.clone());
+        *path = match file.strip_prefix(&to_dir) {
+            Ok(rel) => rel.to_string_lossy().into_owned(),
+            Err(_) => file.to_string_lossy().into_owned(),
+        };
+    };
+    if let Driver::Image { path, .. } = &mut out.driver {
+        fix(path);
+    }
+    if let Some(Environment {
+        source: EnvironmentSource::File { path },
+        ..
+    }) = &mut out.lighting.environment
+    {
+        fix(path);
+    }
+    out
 }
 
 /// Save a material as a preset (atomically).
@@ -277,17 +510,98 @@ mod tests {
         assert_eq!(names.len(), 1, "{names:?}");
     }
 
+    /// A save of the same file interrupted after its temporary file is written keeps the old file
+    /// whole and leaves nothing behind; a temporary file left by a crashed save is removed by the
+    /// next save.
     #[test]
-    fn a_failed_save_keeps_the_old_file() {
+    fn an_interrupted_save_keeps_the_old_file() {
         let d = scratch("failed");
         let p = d.join("m.ron");
         save(&p, &default_material()).expect("save");
         let before = std::fs::read_to_string(&p).expect("read");
-        // A directory in the way of the rename makes the save fail.
-        let blocked = d.join("dir.ron");
-        std::fs::create_dir_all(blocked.join("x")).expect("dir");
-        assert!(save(&blocked, &default_material()).is_err());
+        let mut m = default_material();
+        m.name = "changed".into();
+        let mut seen = String::new();
+        let r = write_atomic_with(&p, &m.to_ron(), |tmp| {
+            seen = std::fs::read_to_string(tmp)?;
+            Err(std::io::Error::other("interrupted"))
+        });
+        assert!(r.is_err());
+        assert!(
+            seen.contains("changed"),
+            "the temporary file held the new text"
+        );
         assert_eq!(std::fs::read_to_string(&p).expect("read"), before);
+        let names = |d: &Path| -> Vec<String> {
+            let mut v: Vec<_> = std::fs::read_dir(d)
+                .expect("dir")
+                .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+                .collect();
+            v.sort();
+            v
+        };
+        assert_eq!(names(&d), ["m.ron"]);
+        // A crash leaves a temporary file (another process's id); the next save removes it.
+        std::fs::write(d.join(".m.ron.4000000001.tmp"), "half a preset").expect("write");
+        save(&p, &m).expect("save");
+        assert_eq!(names(&d), ["m.ron"]);
+        assert_eq!(load(&p).expect("load").name, "changed");
+    }
+
+    /// Saving keeps the file's permissions and a symbolic link (its target is replaced).
+    #[cfg(unix)]
+    #[test]
+    fn saving_keeps_permissions_and_symbolic_links() {
+        use std::os::unix::fs::PermissionsExt;
+        let d = scratch("perms");
+        let real = d.join("real.ron");
+        save(&real, &default_material()).expect("save");
+        std::fs::set_permissions(&real, std::fs::Permissions::from_mode(0o640)).expect("chmod");
+        let link = d.join("link.ron");
+        let _ = std::fs::remove_file(&link);
+        std::os::unix::fs::symlink("real.ron", &link).expect("symlink");
+        let mut m = default_material();
+        m.name = "through the link".into();
+        save(&link, &m).expect("save through the link");
+        assert!(
+            std::fs::symlink_metadata(&link)
+                .expect("link")
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(load(&real).expect("load").name, "through the link");
+        let mode = std::fs::metadata(&real).expect("meta").permissions().mode() & 0o777;
+        assert_eq!(mode, 0o640);
+    }
+
+    /// An exported bundle of a preset with a driver image and an environment file carries copies
+    /// of both and reopens from its own folder; no temporaries are left (#16).
+    #[test]
+    fn bundles_carry_the_files_their_material_names() {
+        let d = scratch("bundle");
+        let presets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../presets");
+        let src = presets.join("cobblestones.ron");
+        let r = load_resolved(&src).expect("cobblestones");
+        let out = d.join("bundle");
+        // A leftover of an interrupted export is cleaned up.
+        std::fs::create_dir_all(&out).expect("dir");
+        std::fs::write(out.join(".data.bin.4000000001.tmp"), "half").expect("write");
+        let written = export_bundle(&r, Some(&src), &out).expect("export");
+        assert!(written.last().is_some_and(|p| p.ends_with("manifest.json")));
+        let reopened = load_resolved(&out.join("material.ron")).expect("the bundle reopens");
+        assert!(reopened.image.is_some());
+        assert!(out.join("driver-cobblestones.png").is_file());
+        let stray: Vec<_> = std::fs::read_dir(&out)
+            .expect("dir")
+            .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+            .filter(|n| n.ends_with(".tmp"))
+            .collect();
+        assert!(stray.is_empty(), "{stray:?}");
+        // Saved into another folder, the material still finds its image.
+        let elsewhere = d.join("elsewhere").join("c.ron");
+        std::fs::create_dir_all(elsewhere.parent().unwrap()).expect("dir");
+        save(&elsewhere, &relocate(&r.material, Some(&src), &elsewhere)).expect("save");
+        assert!(load_resolved(&elsewhere).expect("reopens").image.is_some());
     }
 
     #[test]

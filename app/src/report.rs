@@ -479,11 +479,15 @@ pub fn charts(rep: &Report) -> Vec<(&'static str, Chart, Vec<Series>)> {
 /// Write report.json, report.md and the charts error_vs_time and error_vs_view, each as PNG and
 /// SVG, into `dir`.
 pub fn write(rep: &Report, dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir)?;
-    std::fs::write(dir.join("report.json"), serde_json::to_string_pretty(rep)?)?;
-    std::fs::write(dir.join("report.md"), markdown(rep))?;
+    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    let put = |name: &str, text: String| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))
+    };
+    put("report.json", serde_json::to_string_pretty(rep)?)?;
+    put("report.md", markdown(rep))?;
     for (stem, chart, series) in charts(rep) {
-        std::fs::write(dir.join(format!("{stem}.svg")), chart.svg(&series))?;
+        put(&format!("{stem}.svg"), chart.svg(&series))?;
         let png = dir.join(format!("{stem}.png"));
         chart
             .png(&series)

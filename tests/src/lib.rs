@@ -2,8 +2,9 @@
 //! library with its driver images, and the GPU adapter that tests skip without.
 //!
 //! Never require a GPU: without any adapter (not even Mesa's llvmpipe) a GPU test has nothing to
-//! run on, so [`gpu`] and [`renderer`] say so on stderr and return `None`; CI installs llvmpipe so
-//! they run there.
+//! run on, so [`gpu`] and [`renderer`] say so on stderr and return `None` ([`skip`]); CI installs
+//! llvmpipe so they run there, and sets [`REQUIRE_GPU`] so that a missing adapter fails every GPU
+//! test instead of passing it green, and [`GPU_LOG`] to count the GPU tests that ran.
 
 use lodestone_core::driver::image::ImageDriver;
 use lodestone_core::eval::Evaluator;
@@ -12,16 +13,53 @@ use lodestone_render::{GpuContext, Renderer};
 use std::path::PathBuf;
 use std::sync::Arc;
 
-/// The headless GPU context, or `None` (with "skipping {test}: why" on stderr) when there is no
-/// adapter.
+/// Environment variable: when set (to anything but `0` or nothing), a GPU test without an adapter
+/// fails instead of skipping. `.ci/run` sets it.
+pub const REQUIRE_GPU: &str = "LODESTONE_REQUIRE_GPU";
+
+/// Environment variable: a file to which every GPU test that found an adapter appends a line
+/// (`.ci/run` counts them).
+pub const GPU_LOG: &str = "LODESTONE_GPU_LOG";
+
+/// Whether [`REQUIRE_GPU`] is set.
+pub fn gpu_required() -> bool {
+    std::env::var_os(REQUIRE_GPU).is_some_and(|v| !v.is_empty() && v != "0")
+}
+
+/// A GPU test that has no adapter: "skipping {test}: {why}" on stderr, or a panic when
+/// [`REQUIRE_GPU`] is set.
+pub fn skip(test: &str, why: impl std::fmt::Display) {
+    assert!(
+        !gpu_required(),
+        "{test}: no GPU adapter ({why}), and {REQUIRE_GPU} says this run must have one"
+    );
+    eprintln!("skipping {test}: {why}");
+}
+
+/// A GPU test that found its adapter: "{test} on {adapter}" on stderr and a line in [`GPU_LOG`].
+pub fn ran(test: &str, adapter: &str) {
+    eprintln!("{test} on {adapter}");
+    if let Some(path) = std::env::var_os(GPU_LOG) {
+        use std::io::Write;
+        if let Ok(mut f) = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(path)
+        {
+            let _ = writeln!(f, "{test}\t{adapter}");
+        }
+    }
+}
+
+/// The headless GPU context, or `None` ([`skip`]) when there is no adapter.
 pub fn gpu(test: &str) -> Option<GpuContext> {
     match GpuContext::new_headless() {
         Ok(ctx) => {
-            eprintln!("{test} on {}", ctx.describe());
+            ran(test, &ctx.describe());
             Some(ctx)
         }
         Err(e) => {
-            eprintln!("skipping {test}: {e}");
+            skip(test, e);
             None
         }
     }

@@ -45,8 +45,14 @@ impl EditorApp {
 
     /// Save to `p` (atomically).
     pub fn save_to(&mut self, ctx: &egui::Context, p: &Path) -> bool {
-        match preset_io::save(p, &self.doc.material) {
+        // Into another folder, the driver image and environment paths are rewritten to still name
+        // their files (which restarts the undo history: older states hold the old paths).
+        let relocated = preset_io::relocate(&self.doc.material, self.doc.path.as_deref(), p);
+        match preset_io::save(p, &relocated) {
             Ok(()) => {
+                if relocated != self.doc.material {
+                    self.doc.replace(relocated, Some(p.to_owned()));
+                }
                 self.doc.mark_saved(p);
                 self.remember(p);
                 self.notify(ctx, format!("Saved {}", p.display()), false);

@@ -45,7 +45,7 @@ impl EditorApp {
                     && let Some(dir) = rfd::FileDialog::new().pick_folder()
                 {
                     let preset = self.resolved(&ctx);
-                    match preset_io::export_bundle(&preset, &dir) {
+                    match preset_io::export_bundle(&preset, self.doc.path.as_deref(), &dir) {
                         Ok(w) => self.notify(
                             &ctx,
                             format!("Engine bundle: {} files in {}", w.len(), dir.display()),

@@ -137,7 +137,7 @@ fn error_view_toggles_and_window_snapshots() {
     let mut h = harness(1600.0, 900.0, DeviceSource::Headless);
     h.step();
     if no_adapter(&h) {
-        eprintln!("skipped: no adapter");
+        lodestone_tests::skip("editor test", "no adapter");
         return;
     }
     h.state_mut().view.camera.elevation_deg = 78.0;
@@ -172,7 +172,7 @@ fn default_window_snapshot_at_1280x720() {
     let mut h = harness(1280.0, 720.0, DeviceSource::Headless);
     h.step();
     if no_adapter(&h) {
-        eprintln!("skipped: no adapter");
+        lodestone_tests::skip("editor test", "no adapter");
         return;
     }
     settle(&mut h, Duration::from_secs(240));
@@ -274,7 +274,7 @@ fn exports_every_view_and_error_map_as_png_and_exr() {
     let mut h = harness(800.0, 500.0, DeviceSource::Headless);
     h.step();
     if no_adapter(&h) {
-        eprintln!("skipped: no adapter");
+        lodestone_tests::skip("editor test", "no adapter");
         return;
     }
     h.state_mut().view.show_plots = false;
@@ -324,7 +324,7 @@ fn the_baseline_view_switches_in_place() {
         && t0.elapsed() < Duration::from_secs(60)
     {
         if no_adapter(&h) {
-            eprintln!("skipped: no adapter");
+            lodestone_tests::skip("editor test", "no adapter");
             return;
         }
         h.step();
