@@ -9,6 +9,21 @@ fn lodestone(args: &[&str]) -> std::process::Output {
         .expect("run lodestone")
 }
 
+/// Run `args` and expect exit code 2 within 5 s, with `says` in the message (hostile input is
+/// refused at once, before any work).
+fn assert_refused(args: &[&str], says: &str) {
+    let t = std::time::Instant::now();
+    let out = lodestone(args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    assert!(err.contains(says), "{args:?} should say {says:?}: {err}");
+    let took = t.elapsed();
+    assert!(
+        took.as_secs_f64() < 5.0,
+        "{args:?} refused only after {took:?}"
+    );
+}
+
 #[test]
 fn help_works() {
     let out = lodestone(&["--help"]);
@@ -472,111 +487,41 @@ fn non_finite_and_out_of_range_numbers_exit_2_naming_the_parameter() {
     let out_png = out_png.to_str().unwrap();
     let out_dir = std::env::temp_dir().join(format!("lodestone-cli-range-{}", std::process::id()));
     let out_dir = out_dir.to_str().unwrap();
-    let cases: &[(&[&str], &str)] = &[
-        (&["eval", "--view-deg", "nan"], "view angle"),
-        (&["eval", "--view-deg=-30"], "view angle"),
-        (&["eval", "--view-deg", "100"], "view angle"),
-        (&["eval", "--light-deg", "inf"], "light angle"),
-        (&["eval", "--view-azimuth-deg", "nan"], "azimuth"),
-        (&["eval", "--spp", "0"], "sample count"),
-        (&["eval", "--spp", "1"], "sample count"),
-        (
-            &[
-                "render",
-                "--mode",
-                "naive",
-                "--view-deg",
-                "nan",
-                "--out",
-                out_png,
-            ],
-            "view angle",
-        ),
-        (
-            &[
-                "render",
-                "--mode",
-                "naive",
-                "--distance",
-                "nan",
-                "--out",
-                out_png,
-            ],
-            "distance",
-        ),
-        (
-            &[
-                "render",
-                "--mode",
-                "naive",
-                "--distance",
-                "0",
-                "--out",
-                out_png,
-            ],
-            "distance",
-        ),
-        (
-            &[
-                "render",
-                "--mode",
-                "naive",
-                "--distance=-1",
-                "--out",
-                out_png,
-            ],
-            "distance",
-        ),
-        (
-            &[
-                "render",
-                "--mode",
-                "naive",
-                "--distance",
-                "inf",
-                "--out",
-                out_png,
-            ],
-            "distance",
-        ),
-        (
-            &["render", "--mode", "truth", "--spp", "0", "--out", out_png],
-            "--spp",
-        ),
-        (
-            &[
-                "render", "--shape", "cylinder", "--radius", "nan", "--out", out_dir,
-            ],
-            "radius",
-        ),
-        (&["bench", "--view-deg", "60,nan"], "view angle"),
-        (&["bench", "--distance", "6,0"], "distance"),
-        (&["bench", "--frames", "0"], "--frames"),
-        (
-            &["report", "--out", out_dir, "--views", "nan"],
-            "view angle",
-        ),
-        (
-            &["report", "--out", out_dir, "--zooms", "1.5,inf"],
-            "distance",
-        ),
-        (
-            &["report", "--out", out_dir, "--reference-spp", "0"],
-            "--reference-spp",
-        ),
-        (&["inspect", "--light-deg", "nan"], "light angle"),
+    let naive = |more: &[&'static str]| -> Vec<&str> {
+        let mut v = vec!["render", "--mode", "naive", "--out", out_png];
+        v.extend_from_slice(more);
+        v
+    };
+    let report = |more: &[&'static str]| -> Vec<&str> {
+        let mut v = vec!["report", "--out", out_dir];
+        v.extend_from_slice(more);
+        v
+    };
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (vec!["eval", "--view-deg", "nan"], "view angle"),
+        (vec!["eval", "--view-deg=-30"], "view angle"),
+        (vec!["eval", "--view-deg", "100"], "view angle"),
+        (vec!["eval", "--light-deg", "inf"], "light angle"),
+        (vec!["eval", "--view-azimuth-deg", "nan"], "azimuth"),
+        (vec!["eval", "--spp", "0"], "sample count"),
+        (vec!["eval", "--spp", "1"], "sample count"),
+        (naive(&["--view-deg", "nan"]), "view angle"),
+        (naive(&["--distance", "nan"]), "distance"),
+        (naive(&["--distance", "0"]), "distance"),
+        (naive(&["--distance=-1"]), "distance"),
+        (naive(&["--distance", "inf"]), "distance"),
+        (naive(&["--spp", "0"]), "--spp"),
+        (naive(&["--shape", "cylinder", "--radius", "nan"]), "radius"),
+        (vec!["bench", "--view-deg", "60,nan"], "view angle"),
+        (vec!["bench", "--distance", "6,0"], "distance"),
+        (vec!["bench", "--frames", "0"], "--frames"),
+        (report(&["--views", "nan"]), "view angle"),
+        (report(&["--zooms", "1.5,inf"]), "distance"),
+        (report(&["--reference-spp", "0"]), "--reference-spp"),
+        (vec!["inspect", "--light-deg", "nan"], "light angle"),
     ];
-    for (args, names) in cases {
-        let t = std::time::Instant::now();
-        let out = lodestone(args);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.contains(names), "{args:?} should name {names}: {err}");
-        assert!(
-            t.elapsed().as_secs_f64() < 5.0,
-            "{args:?} refused only after {:?}",
-            t.elapsed()
-        );
+    for (args, says) in &cases {
+        assert_refused(args, says);
     }
     assert!(!std::path::Path::new(out_png).exists(), "nothing written");
     assert!(!std::path::Path::new(out_dir).exists(), "nothing written");
@@ -613,16 +558,7 @@ fn pipes_devices_and_directories_are_refused_at_once() {
         cases.push((image.to_str().unwrap().into(), "not a regular file"));
     }
     for (preset, says) in &cases {
-        let t = std::time::Instant::now();
-        let out = lodestone(&["validate", "--preset", preset]);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{preset}: {err}");
-        assert!(err.contains(says), "{preset}: {err}");
-        assert!(
-            t.elapsed().as_secs_f64() < 5.0,
-            "{preset} took {:?}",
-            t.elapsed()
-        );
+        assert_refused(&["validate", "--preset", preset], says);
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -638,52 +574,22 @@ fn unusable_outputs_are_refused_before_rendering() {
     std::fs::write(&file, "keep me").unwrap();
     let txt = dir.join("image.txt");
     let missing = dir.join("no-such-folder").join("x.png");
-    let cases: Vec<Vec<String>> = vec![
-        vec![
-            "render".into(),
-            "--mode".into(),
-            "naive".into(),
-            "--out".into(),
-            txt.display().to_string(),
-        ],
-        vec![
-            "render".into(),
-            "--mode".into(),
-            "truth".into(),
-            "--out".into(),
-            missing.display().to_string(),
-        ],
-        vec![
-            "render".into(),
-            "--mode".into(),
-            "naive".into(),
-            "--out".into(),
-            dir.display().to_string(),
-        ],
-        vec![
-            "render".into(),
-            "--mode".into(),
-            "all".into(),
-            "--out".into(),
-            file.display().to_string(),
-        ],
-        vec!["report".into(), "--out".into(), file.display().to_string()],
-    ];
-    for args in &cases {
-        let args: Vec<&str> = args.iter().map(String::as_str).collect();
-        let t = std::time::Instant::now();
-        let out = lodestone(&args);
-        let err = String::from_utf8_lossy(&out.stderr);
-        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
-        assert!(
-            err.contains(args[args.len() - 1]),
-            "{args:?} names the path: {err}"
-        );
-        assert!(
-            t.elapsed().as_secs_f64() < 5.0,
-            "{args:?} took {:?}",
-            t.elapsed()
-        );
+    let (file_s, txt_s, missing_s, dir_s) = (
+        file.display().to_string(),
+        txt.display().to_string(),
+        missing.display().to_string(),
+        dir.display().to_string(),
+    );
+    let render = |mode, out| vec!["render", "--mode", mode, "--out", out];
+    for args in [
+        render("naive", &txt_s),
+        render("truth", &missing_s),
+        render("naive", &dir_s),
+        render("all", &file_s),
+        vec!["report", "--out", &file_s],
+    ] {
+        // The message names the path.
+        assert_refused(&args, args[args.len() - 1]);
     }
     assert_eq!(std::fs::read_to_string(&file).unwrap(), "keep me");
     assert!(!txt.exists());
