@@ -420,10 +420,20 @@ fn bundled_material(
             .file_name()
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
-        check_regular_file(&from, MAX_IMAGE_FILE_BYTES).map_err(|e| PresetError::Image {
-            preset: preset_name.to_owned(),
-            image: from.clone(),
-            reason: e.to_string(),
+        check_regular_file(&from, MAX_IMAGE_FILE_BYTES).map_err(|e| {
+            let (preset, reason) = (preset_name.to_owned(), e.to_string());
+            match prefix {
+                "driver-" => PresetError::Image {
+                    preset,
+                    image: from.clone(),
+                    reason,
+                },
+                _ => PresetError::Environment {
+                    preset,
+                    file: from.clone(),
+                    reason,
+                },
+            }
         })?;
         // The driver image and the environment keep distinct names even when theirs agree.
         let name = format!("{prefix}{file}");
