@@ -149,7 +149,7 @@ pub struct EditorApp {
     last_frame: Option<f64>,
     persist: bool,
     title: String,
-    /// Hide timings (frame times, fps) so snapshots are reproducible.
+    /// Hide timings (pass times, fps) and the adapter's name so snapshots are reproducible.
     deterministic: bool,
     /// `LODESTONE_FPS_LOG=1`: repaint continuously and log the window's frame rate (measurements).
     fps_log: Option<f64>,
