@@ -1,7 +1,8 @@
 //! `lodestone stability`: core's stiff and extreme cases (f64 and the f32 mirror, see
 //! [`crate::stability_cases`]) plus the same cases through the WGSL on the GPU adapter.
 //!
-//! WGSL rows: the special functions on the same arguments (bound 1e-5·(1 + x²) relative: WGSL lets
+//! WGSL rows: the special functions on the same arguments (bound 1e-5·(1 + κ) relative, κ the
+//! condition number, [`stability::f32_deviation`]: WGSL lets
 //! `exp`/`log` be off by a few ULP more than Rust's), and every material case rendered far away
 //! (8×8 pixels, camera at the listed angles from the normal plus 60°, every mode, the ground truth
 //! with 1 ray where core traces it too, [`stability::truth_traceable`]): non-finite or negative pixels
@@ -10,9 +11,7 @@
 //! 0.5% + 2e-4 (bound 2%: f32 against f64 rays may cross a shadow edge differently).
 //! `LODESTONE_STABILITY_DEBUG=1` prints every failing WGSL pixel.
 
-use crate::stability_cases::{
-    self as stability, Path, Row, SpecialFunction, deviation, material_cases, special_reference,
-};
+use crate::stability_cases::{self as stability, Path, Row, SpecialFunction, material_cases};
 use anyhow::Result;
 use glam::DVec2;
 use lodestone_core::driver::footprint::Footprint;
@@ -31,15 +30,12 @@ fn wgsl_special_rows(ctx: &GpuContext) -> Vec<Row> {
             let xf: Vec<f32> = xs.iter().map(|x| *x as f32).collect();
             let got = compute::eval_unary(ctx, shaders::SPECIAL, name, &xf);
             let (mut dev, mut bad) = (0.0f64, 0);
-            for ((x, g), xs32) in xs.iter().zip(&got).zip(&xf) {
+            for (g, xs32) in got.iter().zip(&xf) {
                 let g = f64::from(*g);
                 if !g.is_finite() {
                     bad += 1;
                 }
-                let r = special_reference(function, *x)
-                    .clamp(-f64::from(f32::MAX), f64::from(f32::MAX));
-                let x2 = f64::from(*xs32).powi(2).min(1e6);
-                dev = dev.max(deviation(g, r, 1e-30) / (1.0 + x2));
+                dev = dev.max(stability::f32_deviation(function, *xs32, g));
             }
             Row {
                 case: format!("{name} at {} extreme arguments", xs.len()),
@@ -48,7 +44,8 @@ fn wgsl_special_rows(ctx: &GpuContext) -> Vec<Row> {
                 max_deviation: dev,
                 bound: 1e-5,
                 non_finite: bad,
-                reference: "quadrature (relative / (1 + x²))".into(),
+                reference: "quadrature at the f32 argument (relative / (1 + condition number))"
+                    .into(),
             }
         })
         .collect()

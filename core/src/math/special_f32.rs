@@ -110,9 +110,12 @@ pub fn norm_cdf(z: f32) -> f32 {
 /// ln Φ(z); finite for every finite z (uses erfcx below z = −3; `ln(1 − Q)` by its series for small Q).
 pub fn log_norm_cdf(z: f32) -> f32 {
     if z < -3.0 {
-        // x² overflows f32 beyond x ≈ 1.8e19: the argument is bounded there (as in the WGSL, which
-        // cannot test for infinity reliably) and the result saturates at f32::MIN.
-        let x = (-z * std::f32::consts::FRAC_1_SQRT_2).min(1.8e19);
+        // x² overflows f32 beyond x ≈ 1.8e19, where ln Φ < −1.6e38: the result saturates at
+        // f32::MIN there (as in the WGSL, which cannot test for infinity reliably).
+        let x = -z * std::f32::consts::FRAC_1_SQRT_2;
+        if x >= 1.8e19 {
+            return f32::MIN;
+        }
         ((0.5 * erfcx(x)).ln() - x * x).max(f32::MIN)
     } else if z < 0.0 {
         norm_cdf(z).ln()

@@ -89,9 +89,12 @@ fn norm_cdf(z: f32) -> f32 {
 
 fn log_norm_cdf(z: f32) -> f32 {
     if (z < -3.0) {
-        // x² overflows f32 beyond x ≈ 1.8e19: saturate like core's f32::MIN (WGSL cannot test for
-        // infinity reliably, so the argument is bounded instead).
-        let x = min(-z * FRAC_1_SQRT_2, 1.8e19);
+        // x² overflows f32 beyond x ≈ 1.8e19: saturate at core's f32::MIN (WGSL cannot test for
+        // infinity reliably, so the argument is compared instead).
+        let x = -z * FRAC_1_SQRT_2;
+        if (x >= 1.8e19) {
+            return -3.4028235e38;
+        }
         return max(log(0.5 * erfcx(x)) - x * x, -3.4028235e38);
     } else if (z < 0.0) {
         return log(norm_cdf(z));
