@@ -25,6 +25,7 @@ mod render_cmd;
 mod report;
 mod stability;
 mod stability_cases;
+mod stability_materials;
 
 use anyhow::{Context, Result};
 use clap::Parser;

@@ -2,7 +2,7 @@
 //! [`crate::stability_cases`]) plus the same cases through the WGSL on the GPU adapter.
 //!
 //! WGSL rows: the special functions on the same arguments (bound 1e-5·(1 + κ) relative, κ the
-//! condition number, [`stability::f32_deviation`]: WGSL lets
+//! condition number, [`crate::stability_cases::f32_deviation`]: WGSL lets
 //! `exp`/`log` be off by a few ULP more than Rust's), and every material case rendered far away
 //! (8×8 pixels, camera at the listed angles from the normal plus 60°, every mode, the ground truth
 //! with 1 ray where core traces it too, [`stability::truth_traceable`]): non-finite or negative pixels
@@ -11,7 +11,8 @@
 //! 0.5% + 2e-4 (bound 2%: f32 against f64 rays may cross a shadow edge differently).
 //! `LODESTONE_STABILITY_DEBUG=1` prints every failing WGSL pixel.
 
-use crate::stability_cases::{self as stability, Path, Row, SpecialFunction, material_cases};
+use crate::stability_cases::{Path, Row, SpecialFunction};
+use crate::stability_materials::{self as stability, material_cases};
 use anyhow::Result;
 use glam::DVec2;
 use lodestone_core::driver::footprint::Footprint;
@@ -35,7 +36,7 @@ fn wgsl_special_rows(ctx: &GpuContext) -> Vec<Row> {
                 if !g.is_finite() {
                     bad += 1;
                 }
-                dev = dev.max(stability::f32_deviation(function, *xs32, g));
+                dev = dev.max(crate::stability_cases::f32_deviation(function, *xs32, g));
             }
             Row {
                 case: format!("{name} at {} extreme arguments", xs.len()),
@@ -174,7 +175,7 @@ fn wgsl_material_rows(r: &Renderer) -> Vec<Row> {
 
 /// Every row: CPU, then WGSL when an adapter is found (otherwise a note on stderr).
 pub fn rows() -> Vec<Row> {
-    let mut rows = stability::cpu_rows();
+    let mut rows = crate::stability_cases::cpu_rows();
     match GpuContext::new_headless() {
         Ok(ctx) => {
             rows.extend(wgsl_special_rows(&ctx));
