@@ -9,18 +9,87 @@ fn lodestone(args: &[&str]) -> std::process::Output {
         .expect("run lodestone")
 }
 
-/// Run `args` and expect exit code 2 within 5 s, with `says` in the message (hostile input is
-/// refused at once, before any work).
-fn assert_refused(args: &[&str], says: &str) {
+/// How a run went: its output, wall time and peak resident memory.
+struct Measured {
+    out: std::process::Output,
+    took: std::time::Duration,
+    /// Peak resident set (VmHWM), polled every 2 ms from /proc while the process runs (a lower
+    /// bound by at most the last 2 ms of growth; 0 where /proc is absent). The high-water mark only
+    /// grows, so a runaway allocation (the 4 GB of `--preset /dev/zero`) cannot slip between polls.
+    peak_bytes: u64,
+}
+
+/// Run lodestone with `args`, killed after `limit`, measuring time and peak memory.
+fn run_measured(args: &[&str], limit: std::time::Duration) -> Measured {
+    use std::io::Read;
+    use std::process::Stdio;
     let t = std::time::Instant::now();
-    let out = lodestone(args);
-    let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_lodestone"))
+        .args(args)
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run lodestone");
+    let (mut so, mut se) = (child.stdout.take().unwrap(), child.stderr.take().unwrap());
+    let out_reader = std::thread::spawn(move || {
+        let mut v = vec![];
+        let _ = so.read_to_end(&mut v);
+        v
+    });
+    let err_reader = std::thread::spawn(move || {
+        let mut v = vec![];
+        let _ = se.read_to_end(&mut v);
+        v
+    });
+    let status_path = format!("/proc/{}/status", child.id());
+    let mut peak_bytes = 0u64;
+    let status = loop {
+        if let Ok(text) = std::fs::read_to_string(&status_path) {
+            if let Some(kb) = text
+                .lines()
+                .find_map(|l| l.strip_prefix("VmHWM:"))
+                .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
+            {
+                peak_bytes = peak_bytes.max(kb * 1024);
+            }
+        }
+        if let Some(status) = child.try_wait().expect("wait") {
+            break status;
+        }
+        if t.elapsed() > limit {
+            let _ = child.kill();
+            break child.wait().expect("wait");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(2));
+    };
+    Measured {
+        out: std::process::Output {
+            status,
+            stdout: out_reader.join().unwrap(),
+            stderr: err_reader.join().unwrap(),
+        },
+        took: t.elapsed(),
+        peak_bytes,
+    }
+}
+
+/// Hostile input is refused at once, before any work: exit code 2 within 10 s and under 1 GiB of
+/// memory, with `says` in the message.
+fn assert_refused(args: &[&str], says: &str) {
+    let m = run_measured(args, std::time::Duration::from_secs(30));
+    let err = String::from_utf8_lossy(&m.out.stderr);
+    assert_eq!(m.out.status.code(), Some(2), "{args:?}: {err}");
     assert!(err.contains(says), "{args:?} should say {says:?}: {err}");
-    let took = t.elapsed();
     assert!(
-        took.as_secs_f64() < 5.0,
-        "{args:?} refused only after {took:?}"
+        m.took.as_secs_f64() < 10.0,
+        "{args:?} refused only after {:?}",
+        m.took
+    );
+    assert!(
+        m.peak_bytes < 1 << 30,
+        "{args:?} used {} MiB before refusing",
+        m.peak_bytes >> 20
     );
 }
 
@@ -649,6 +718,108 @@ fn show_and_render_produce_what_they_say() {
     for name in ["naive", "view_independent", "filtered"] {
         assert!(dir.join(format!("error_{name}.png")).is_file());
         assert!(dir.join(format!("error_{name}.exr")).is_file());
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The hostile-input suite (#16): presets that ask for unbounded work or memory, non-finite and
+/// oversized numbers, 10⁵ colour stops and curve points, tables and noise beyond their caps,
+/// an environment whose texels overflow f32 sums, deep nesting and a file over the size cap. Each
+/// is refused by `validate` and by `eval` with exit code 2 naming what is wrong, within 10 s and
+/// 1 GiB ([`assert_refused`]).
+#[test]
+fn hostile_presets_are_refused_in_bounded_time_and_memory() {
+    let dir = std::env::temp_dir().join(format!("lodestone-cli-hostile-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let default = include_str!("../../presets/default.ron");
+    let sky = include_str!("../../presets/snow-under-sky.ron");
+    let stops_block = {
+        let start = default.find("stops: [").expect("stops");
+        let end = start + default[start..].find("],").expect("end of stops") + 2;
+        &default[start..end]
+    };
+    let many_stops = {
+        let mut s = String::from("stops: [");
+        for i in 0..100_000 {
+            s += &format!(
+                "ColorStop(position: {}, color: (0.5, 0.5, 0.5)),",
+                f64::from(i) * 1e-5
+            );
+        }
+        s + "],"
+    };
+    let many_points = {
+        let mut s = String::from("transfer: Curve((points: [");
+        for i in 0..100_000 {
+            let f = -3.0 + 6.0 * f64::from(i) / 1e5;
+            s += &format!("({f}, {f}),");
+        }
+        s + "], interpolation: Linear)),"
+    };
+    // An environment whose texels are 3e38 (their sums overflowed f32 on the GPU).
+    let mut hot = image::Rgb32FImage::new(8, 4);
+    for p in hot.pixels_mut() {
+        p.0 = [3e38; 3];
+    }
+    hot.save(dir.join("hot.exr")).unwrap();
+    let nested = format!("{}{}", "[".repeat(200_000), "]".repeat(200_000));
+    let oversized = format!("{default}{}", " ".repeat(16 << 20));
+    let cases: Vec<(&str, String, &str)> = vec![
+        ("stops", default.replace(stops_block, &many_stops), "stops"),
+        (
+            "points",
+            default.replace("transfer: Identity,", &many_points),
+            "points",
+        ),
+        (
+            "table",
+            default.replace("size_m: 256", "size_m: 4096"),
+            "size_m",
+        ),
+        (
+            "slopes",
+            default.replace("sigma_nx: 0.35", "sigma_nx: 1e6"),
+            "sigma_nx",
+        ),
+        (
+            "nan",
+            default.replace("sigma_h: 0.05", "sigma_h: NaN"),
+            "sigma_h",
+        ),
+        (
+            "inf",
+            default.replace("roughness: 0.15", "roughness: inf"),
+            "roughness",
+        ),
+        (
+            "huge",
+            default.replace("sigma_h: 0.05", "sigma_h: 1e300"),
+            "sigma_h",
+        ),
+        (
+            "waves",
+            default.replace("components: 48", "components: 4000000000"),
+            "components",
+        ),
+        (
+            "points8",
+            default.replace("slope_points: 8", "slope_points: 4000000000"),
+            "slope_points",
+        ),
+        (
+            "hot",
+            sky.replace("source: Sky(())", "source: File(path: \"hot.exr\")"),
+            "hot.exr",
+        ),
+        ("nested", nested, "line 1"),
+        ("oversized", oversized, "byte limit"),
+    ];
+    for (name, text, says) in &cases {
+        let path = dir.join(format!("{name}.ron"));
+        std::fs::write(&path, text).unwrap();
+        let p = path.to_str().unwrap();
+        assert_refused(&["validate", "--preset", p], says);
+        assert_refused(&["--preset", p, "eval", "--spp", "16"], says);
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
