@@ -45,14 +45,13 @@ fn run_measured(args: &[&str], limit: std::time::Duration) -> Measured {
     let status_path = format!("/proc/{}/status", child.id());
     let mut peak_bytes = 0u64;
     let status = loop {
-        if let Ok(text) = std::fs::read_to_string(&status_path) {
-            if let Some(kb) = text
+        if let Ok(text) = std::fs::read_to_string(&status_path)
+            && let Some(kb) = text
                 .lines()
                 .find_map(|l| l.strip_prefix("VmHWM:"))
                 .and_then(|v| v.trim().trim_end_matches("kB").trim().parse::<u64>().ok())
-            {
-                peak_bytes = peak_bytes.max(kb * 1024);
-            }
+        {
+            peak_bytes = peak_bytes.max(kb * 1024);
         }
         if let Some(status) = child.try_wait().expect("wait") {
             break status;
