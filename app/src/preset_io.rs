@@ -262,14 +262,19 @@ pub fn load_image_driver(preset: &Path, image: &Path) -> Result<ImageDriver, Pre
 /// itself survives a power cut. A symbolic link is kept: its target is replaced. Temporary files
 /// that an earlier, crashed save of the same target left behind are removed.
 pub fn write_atomic(path: &Path, text: &str) -> Result<(), PresetError> {
-    write_atomic_with(path, text, |_| Ok(()))
+    write_atomic_with(path, text.as_bytes(), |_| Ok(()))
+}
+
+/// [`write_atomic`] for bytes (rendered images).
+pub fn write_atomic_bytes(path: &Path, bytes: &[u8]) -> Result<(), PresetError> {
+    write_atomic_with(path, bytes, |_| Ok(()))
 }
 
 /// [`write_atomic`] with `before_rename` run on the written temporary file just before the rename
 /// (tests interrupt a save there).
 fn write_atomic_with(
     path: &Path,
-    text: &str,
+    bytes: &[u8],
     before_rename: impl FnOnce(&Path) -> std::io::Result<()>,
 ) -> Result<(), PresetError> {
     let err = |error| PresetError::Write {
@@ -295,7 +300,7 @@ fn write_atomic_with(
     let old = std::fs::metadata(&target).ok();
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(text.as_bytes())?;
+        f.write_all(bytes)?;
         if let Some(m) = &old {
             f.set_permissions(m.permissions())?;
         }
@@ -370,6 +375,16 @@ pub fn export_bundle(
     }
     // The manifest goes last: a bundle with a manifest is complete.
     files.sort_by_key(|(name, _)| name == "manifest.json");
+    write_set(dir, &files)
+}
+
+/// Write a set of files into `dir` (created if needed) so that it is never seen half written:
+/// every file first goes to a temporary name in `dir` and is flushed; only then are they renamed
+/// into place, in the order given (put the file that marks a set complete last). An interrupted
+/// write leaves the previous set, plus temporaries that the next write of the same names removes.
+/// Returns the files written.
+pub fn write_set(dir: &Path, files: &[(String, Vec<u8>)]) -> anyhow::Result<Vec<PathBuf>> {
+    use anyhow::Context;
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let staged: Vec<(PathBuf, PathBuf)> = files
         .iter()
@@ -383,7 +398,7 @@ pub fn export_bundle(
         })
         .collect();
     let result = (|| -> anyhow::Result<()> {
-        for ((tmp, _), (_, bytes)) in staged.iter().zip(&files) {
+        for ((tmp, _), (_, bytes)) in staged.iter().zip(files) {
             let mut f =
                 std::fs::File::create(tmp).with_context(|| format!("writing {}", tmp.display()))?;
             f.write_all(bytes)
@@ -520,6 +535,39 @@ mod tests {
         assert_eq!(names.len(), 1, "{names:?}");
     }
 
+    /// A set of files (render --mode all, export) that fails while being written leaves the
+    /// previous set as it was and no temporaries (#16: render --mode all left partial sets).
+    #[test]
+    fn a_failed_set_keeps_the_previous_set() {
+        let d = scratch("set");
+        let set = |v: &str| -> Vec<(String, Vec<u8>)> {
+            ["a.png", "b.exr", "c.png"]
+                .iter()
+                .map(|n| (n.to_string(), v.as_bytes().to_vec()))
+                .collect()
+        };
+        let written = write_set(&d, &set("old")).expect("first set");
+        assert_eq!(written.len(), 3);
+        // The third file cannot be staged (its folder does not exist): nothing is replaced.
+        let mut bad = set("new");
+        bad[2].0 = "missing/c.png".into();
+        assert!(write_set(&d, &bad).is_err());
+        for n in ["a.png", "b.exr", "c.png"] {
+            assert_eq!(
+                std::fs::read_to_string(d.join(n)).expect("kept"),
+                "old",
+                "{n}"
+            );
+        }
+        let names: Vec<_> = std::fs::read_dir(&d)
+            .expect("dir")
+            .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names.len(), 3, "temporaries left: {names:?}");
+        write_set(&d, &set("new")).expect("second set");
+        assert_eq!(std::fs::read_to_string(d.join("b.exr")).expect("b"), "new");
+    }
+
     /// A save of the same file interrupted after its temporary file is written keeps the old file
     /// whole and leaves nothing behind; a temporary file left by a crashed save is removed by the
     /// next save.
@@ -532,7 +580,7 @@ mod tests {
         let mut m = default_material();
         m.name = "changed".into();
         let mut seen = String::new();
-        let r = write_atomic_with(&p, &m.to_ron(), |tmp| {
+        let r = write_atomic_with(&p, m.to_ron().as_bytes(), |tmp| {
             seen = std::fs::read_to_string(tmp)?;
             Err(std::io::Error::other("interrupted"))
         });

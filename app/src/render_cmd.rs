@@ -55,26 +55,43 @@ impl View {
     }
 }
 
+/// The image encoded as `ext` ("png": sRGB 8-bit, "exr": linear f32), in memory.
+fn encode(img: &LinearImage, ext: &str) -> Result<Vec<u8>> {
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    match ext {
+        "png" => img.to_srgb8().write_to(&mut bytes, image::ImageFormat::Png),
+        "exr" => image::DynamicImage::ImageRgba32F(img.to_linear_f32())
+            .write_to(&mut bytes, image::ImageFormat::OpenExr),
+        _ => bail!("unsupported output format .{ext} (use .png or .exr)"),
+    }
+    .with_context(|| format!("encoding {ext}"))?;
+    Ok(bytes.into_inner())
+}
+
+/// Write one image atomically (an interrupted run leaves the old file or none, never half a file).
 fn save(img: &LinearImage, path: &Path) -> Result<()> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
-    match ext.as_str() {
-        "png" => img.to_srgb8().save(path),
-        "exr" => image::DynamicImage::ImageRgba32F(img.to_linear_f32()).save(path),
-        _ => bail!("unsupported output {} (use .png or .exr)", path.display()),
-    }
-    .with_context(|| format!("writing {}", path.display()))
+    let bytes = encode(img, &ext).with_context(|| format!("writing {}", path.display()))?;
+    crate::preset_io::write_atomic_bytes(path, &bytes)?;
+    Ok(())
 }
 
-fn save_as(img: &LinearImage, dir: &Path, name: &str, formats: Formats) -> Result<()> {
+/// `name.png` and/or `name.exr`, encoded, for a set written at once.
+fn encoded_as(
+    img: &LinearImage,
+    name: &str,
+    formats: Formats,
+    set: &mut Vec<(String, Vec<u8>)>,
+) -> Result<()> {
     if formats != Formats::Exr {
-        save(img, &dir.join(format!("{name}.png")))?;
+        set.push((format!("{name}.png"), encode(img, "png")?));
     }
     if formats != Formats::Png {
-        save(img, &dir.join(format!("{name}.exr")))?;
+        set.push((format!("{name}.exr"), encode(img, "exr")?));
     }
     Ok(())
 }
@@ -119,7 +136,6 @@ pub fn render(
             save(&heat_map(&f, &t, s.max), out)?;
         }
         RenderMode::All => {
-            std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
             let truth = draw(ViewMode::Truth)?;
             let modes = [
                 ("naive", draw(ViewMode::Naive)?),
@@ -131,25 +147,29 @@ pub fn render(
                 .iter()
                 .map(|(_, i)| error_stats(i, &truth).max)
                 .fold(0.0, f64::max);
+            // Every file is encoded first and the set written at once (staged, then renamed):
+            // an interrupted run leaves the previous set, never a mix.
+            let mut set = Vec::new();
             for (name, img) in &modes {
                 let s = error_stats(img, &truth);
                 outln!("{name:>16} vs truth: RMSE {:.5}, max {:.5}", s.rmse, s.max);
-                save_as(img, out, name, formats)?;
-                save(
-                    &heat_map(img, &truth, scale),
-                    &out.join(format!("error_{name}.png")),
-                )?;
+                encoded_as(img, name, formats, &mut set)?;
+                set.push((
+                    format!("error_{name}.png"),
+                    encode(&heat_map(img, &truth, scale), "png")?,
+                ));
                 if formats != Formats::Png {
-                    save(
-                        &abs_difference(img, &truth),
-                        &out.join(format!("error_{name}.exr")),
-                    )?;
+                    set.push((
+                        format!("error_{name}.exr"),
+                        encode(&abs_difference(img, &truth), "exr")?,
+                    ));
                 }
             }
             outln!(
                 "error maps share the legend 0 … {scale:.5} (linear RGB), truth {spp} rays/pixel"
             );
-            save_as(&truth, out, "truth", formats)?;
+            encoded_as(&truth, "truth", formats, &mut set)?;
+            crate::preset_io::write_set(out, &set)?;
         }
     }
     Ok(())
