@@ -127,8 +127,12 @@ impl EditorApp {
         if same {
             return;
         }
+        // Until the material's files have loaded there is nothing to render (no request: the
+        // next frame asks again).
+        let Some(resolved) = self.resolved(ctx) else {
+            return;
+        };
         self.generation += 1;
-        let resolved = self.resolved(ctx);
         let req = Request {
             generation: self.generation,
             material: Arc::new(self.doc.material.clone()),

@@ -43,8 +43,8 @@ impl EditorApp {
                     .on_hover_text("Tables (EXR), manifest (JSON) and WGSL/GLSL snippets that evaluate the filtered material in another engine")
                     .clicked()
                     && let Some(dir) = rfd::FileDialog::new().pick_folder()
+                    && let Some(preset) = self.resolved_now(&ctx)
                 {
-                    let preset = self.resolved(&ctx);
                     match preset_io::export_bundle(&preset, self.doc.path.as_deref(), &dir) {
                         Ok(w) => self.notify(
                             &ctx,

@@ -151,6 +151,8 @@ pub struct EditorApp {
     title: String,
     /// Hide timings (pass times, fps) and the adapter's name so snapshots are reproducible.
     deterministic: bool,
+    /// Files of the material still loading (status bar).
+    loading: Vec<PathBuf>,
     /// `LODESTONE_FPS_LOG=1`: repaint continuously and log the window's frame rate (measurements).
     fps_log: Option<f64>,
 }
@@ -232,6 +234,7 @@ impl EditorApp {
             persist: options.persist,
             title: String::new(),
             deterministic: false,
+            loading: Vec::new(),
             fps_log: std::env::var_os("LODESTONE_FPS_LOG").map(|_| 0.0),
         };
         app.recent.retain(|p| p.exists());
@@ -293,13 +296,33 @@ impl EditorApp {
     /// The material with its driver image and environment file, loaded relative to the preset's
     /// folder (the current directory for an unsaved material). A load failure is reported once per
     /// path and leaves the file out (the views then show the material error, or no environment).
-    fn resolved(&mut self, ctx: &egui::Context) -> preset_io::Resolved {
+    /// `None` while a file is still loading (the status bar says which; the window repaints until
+    /// it has loaded).
+    fn resolved(&mut self, ctx: &egui::Context) -> Option<preset_io::Resolved> {
         let files = self.load_files(ctx);
-        preset_io::Resolved {
+        if !files.pending.is_empty() {
+            ctx.request_repaint_after(std::time::Duration::from_millis(30));
+            return None;
+        }
+        Some(preset_io::Resolved {
             material: self.doc.material.clone(),
             image: files.image,
             environment: files.environment,
+        })
+    }
+
+    /// [`Self::resolved`] for a command the user asked for: while a file loads, a notice says so.
+    fn resolved_now(&mut self, ctx: &egui::Context) -> Option<preset_io::Resolved> {
+        let r = self.resolved(ctx);
+        if r.is_none() {
+            let files = self.loading.iter().map(|p| p.display().to_string());
+            let text = format!(
+                "Still loading {}: try again when it has loaded",
+                files.collect::<Vec<_>>().join(", ")
+            );
+            self.notify(ctx, text, true);
         }
+        r
     }
 
     /// The document's files ([`Document::load_files`]), each new failure reported once.
@@ -308,6 +331,7 @@ impl EditorApp {
         for e in std::mem::take(&mut files.new_errors) {
             self.notify(ctx, e, true);
         }
+        self.loading.clone_from(&files.pending);
         files
     }
 
@@ -387,8 +411,9 @@ impl eframe::App for EditorApp {
             }
         }
 
-        if self.report.ui(&ctx) == report_panel::Action::Start {
-            let preset = self.resolved(&ctx);
+        if self.report.ui(&ctx) == report_panel::Action::Start
+            && let Some(preset) = self.resolved_now(&ctx)
+        {
             self.report.start(preset, ctx.clone());
         }
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
@@ -424,9 +449,11 @@ impl eframe::App for EditorApp {
             let light = self.view.light();
             let az = self.view.camera.azimuth_deg;
             let interacting = ctx.egui_is_using_pointer();
-            if !interacting && self.doc.material.validate().is_ok() {
+            if !interacting
+                && self.doc.material.validate().is_ok()
+                && let Some(preset) = self.resolved(&ctx)
+            {
                 let c = ctx.clone();
-                let preset = self.resolved(&ctx);
                 self.plots
                     .follow(&preset, light, az, move || c.request_repaint());
             }

@@ -21,6 +21,15 @@ impl EditorApp {
                 }
             };
             ui.separator();
+            for p in &self.loading {
+                let name = p.file_name().map_or_else(
+                    || p.display().to_string(),
+                    |n| n.to_string_lossy().into_owned(),
+                );
+                ui.add(egui::Spinner::new());
+                ui.weak(format!("Loading {name}…"));
+                ui.separator();
+            }
             for m in self.view.needed() {
                 if let Some(s) = self.shown.get(&m) {
                     let f = &s.frame;

@@ -548,11 +548,24 @@ fn regenerate_report_screenshot() {
 /// An image driver's histogram shape is measured and shown in the inspector (cobblestones: skewness
 /// −0.27, excess kurtosis −0.78, the values `cargo run --example cobblestones` prints).
 #[test]
-fn image_driver_histogram_shape_is_shown() {
+fn image_driver_loads_off_the_ui_thread_and_its_histogram_shape_is_shown() {
     let mut h = harness(1400.0, 800.0, DeviceSource::Unavailable);
     let ctx = h.ctx.clone();
     h.state_mut().open_path(&ctx, &preset("cobblestones.ron"));
-    h.run_steps(3);
+    // The first frame starts the load on its own thread (document.rs tests a slow one) and
+    // returns; later frames pick the image up.
+    let t0 = Instant::now();
+    h.step();
+    while h.state().inspector.driver_shape.is_none() {
+        assert!(
+            t0.elapsed() < Duration::from_secs(30),
+            "the image never loaded"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+        h.step();
+    }
+    h.run_steps(2);
+    assert!(h.state().loading.is_empty());
     let (s, k) = h
         .state()
         .inspector
