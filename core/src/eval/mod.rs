@@ -40,6 +40,8 @@ pub mod shading;
 pub mod view_independent;
 
 #[cfg(test)]
+mod independent;
+#[cfg(test)]
 pub(crate) mod test_materials;
 #[cfg(test)]
 mod tests;
