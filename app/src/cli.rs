@@ -175,11 +175,16 @@ pub enum Command {
     },
     /// Run stiff and extreme cases (grazing angles, σ → 0 and 1e6, anisotropy 1e±6, L to 1e12, step
     /// maps, vertical transfer segments, constant images) through core f64, its f32 mirror and the
-    /// WGSL; exit code 1 if any output is non-finite or exceeds its documented bound.
+    /// WGSL; exit code 1 if any output is non-finite or exceeds its documented bound, 3 if the WGSL
+    /// rows could not run.
     Stability {
         /// Print JSON instead of a table.
         #[arg(long)]
         json: bool,
+        /// Only core's f64 and f32 rows (without it, no GPU adapter is exit code 3: the WGSL rows
+        /// did not run).
+        #[arg(long)]
+        cpu_only: bool,
     },
 }
 

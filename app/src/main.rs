@@ -282,7 +282,7 @@ fn run(cli: Cli) -> Result<()> {
         }
         Some(Command::Validate) => outln!("ok: {} is a valid preset", material.name),
         Some(Command::Show) => outln!("{}", material.to_ron()),
-        Some(Command::Stability { json }) => stability::run(json)?,
+        Some(Command::Stability { json, cpu_only }) => stability::run(json, cpu_only)?,
         Some(Command::Report {
             out,
             size,

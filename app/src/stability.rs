@@ -173,17 +173,21 @@ fn wgsl_material_rows(r: &Renderer) -> Vec<Row> {
         .collect()
 }
 
-/// Every row: CPU, then WGSL when an adapter is found (otherwise a note on stderr).
-pub fn rows() -> Vec<Row> {
+/// Every row: CPU, then (unless `cpu_only`) WGSL on the adapter, and the reason there are no WGSL
+/// rows when no adapter was found.
+pub fn rows(cpu_only: bool) -> (Vec<Row>, Option<lodestone_render::GpuError>) {
     let mut rows = crate::stability_cases::cpu_rows();
+    if cpu_only {
+        return (rows, None);
+    }
     match GpuContext::new_headless() {
         Ok(ctx) => {
             rows.extend(wgsl_special_rows(&ctx));
             rows.extend(wgsl_material_rows(&Renderer::new(ctx)));
+            (rows, None)
         }
-        Err(e) => eprintln!("no GPU adapter, WGSL rows skipped: {e}"),
+        Err(e) => (rows, Some(e)),
     }
-    rows
 }
 
 /// The table.
@@ -207,9 +211,11 @@ pub fn table(rows: &[Row]) -> String {
     s
 }
 
-/// `lodestone stability [--json]`: prints the table (or JSON) and fails when a row fails.
-pub fn run(json: bool) -> Result<()> {
-    let rows = rows();
+/// `lodestone stability [--json] [--cpu-only]`: prints the table (or JSON) and fails when a row
+/// fails, or (exit code 3) when the WGSL rows could not run for want of an adapter: a run without
+/// them is not a pass unless `--cpu-only` asked for core alone.
+pub fn run(json: bool, cpu_only: bool) -> Result<()> {
+    let (rows, no_gpu) = rows(cpu_only);
     if json {
         outln!("{}", serde_json::to_string_pretty(&rows)?);
     } else {
@@ -222,6 +228,11 @@ pub fn run(json: bool) -> Result<()> {
     let failed = rows.iter().filter(|r| !r.passed()).count();
     if failed > 0 {
         anyhow::bail!("{failed} of {} stability rows failed", rows.len());
+    }
+    if let Some(e) = no_gpu {
+        return Err(anyhow::Error::new(e).context(
+            "the WGSL rows did not run (the CPU rows above passed; --cpu-only checks core alone)",
+        ));
     }
     Ok(())
 }

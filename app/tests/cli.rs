@@ -258,8 +258,9 @@ fn export_writes_the_engine_bundle() {
 fn stability_passes_and_reports_json() {
     let out = lodestone(&["stability", "--json"]);
     let text = String::from_utf8_lossy(&out.stdout);
+    let no_adapter = out.status.code() == Some(3);
     assert!(
-        out.status.success(),
+        out.status.success() || no_adapter,
         "{}\n{text}",
         String::from_utf8_lossy(&out.stderr)
     );
@@ -276,13 +277,34 @@ fn stability_passes_and_reports_json() {
     for path in ["CoreF64", "CoreF32"] {
         assert!(rows.iter().any(|r| r["path"] == path), "no {path} rows");
     }
-    // Without an adapter the WGSL rows are missing (stderr says so): a skip, not a pass.
-    if rows.iter().any(|r| r["path"] == "Wgsl") {
-        lodestone_tests::ran("stability's WGSL rows", "the CLI's adapter");
-    } else {
+    // Without an adapter the WGSL rows are missing and the exit code is 3 (stderr says why): a
+    // skip, not a pass. With one, they are there.
+    if no_adapter {
+        assert!(!rows.iter().any(|r| r["path"] == "Wgsl"));
         lodestone_tests::skip(
             "stability's WGSL rows",
             String::from_utf8_lossy(&out.stderr),
+        );
+    } else {
+        assert!(rows.iter().any(|r| r["path"] == "Wgsl"), "no WGSL rows");
+        lodestone_tests::ran("stability's WGSL rows", "the CLI's adapter");
+    }
+    // Without an adapter (Metal does not exist here) stability is exit code 3, not a pass;
+    // --cpu-only checks core alone and passes.
+    if !cfg!(target_os = "macos") {
+        let out = Command::new(env!("CARGO_BIN_EXE_lodestone"))
+            .args(["stability"])
+            .env("WGPU_BACKEND", "metal")
+            .output()
+            .expect("run lodestone");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(3), "{err}");
+        assert!(err.contains("WGSL rows did not run"), "{err}");
+        let out = lodestone(&["stability", "--cpu-only", "--json"]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
         );
     }
 }
