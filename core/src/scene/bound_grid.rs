@@ -131,7 +131,7 @@ impl BoundGrid {
                     .sum()
             })
             .collect();
-        let mut level: Vec<[f32; 2]> = (0..n * n)
+        let level: Vec<[f32; 2]> = (0..n * n)
             .map(|idx| {
                 let (i, j) = (idx % n, idx / n);
                 let c = [
@@ -147,18 +147,16 @@ impl BoundGrid {
                 [down(lo - slack - eps), up(hi + slack + eps)]
             })
             .collect();
-        let mut levels = vec![];
+        // Coarser levels: the min and max of 2×2 cells of the level below.
+        let mut levels = vec![level];
         let mut size = n;
-        loop {
-            levels.push(level.clone());
-            if size == 1 {
-                break;
-            }
+        while size > 1 {
+            let below = levels.last().expect("a level");
             let half_size = size / 2;
-            level = (0..half_size * half_size)
+            let next = (0..half_size * half_size)
                 .map(|idx| {
                     let (i, j) = (2 * (idx % half_size), 2 * (idx / half_size));
-                    let at = |i: usize, j: usize| levels.last().expect("a level")[j * size + i];
+                    let at = |i: usize, j: usize| below[j * size + i];
                     let c = [at(i, j), at(i + 1, j), at(i, j + 1), at(i + 1, j + 1)];
                     [
                         c.iter().map(|r| r[0]).fold(f32::INFINITY, f32::min),
@@ -166,6 +164,7 @@ impl BoundGrid {
                     ]
                 })
                 .collect();
+            levels.push(next);
             size = half_size;
         }
         Some(Self {
@@ -185,21 +184,21 @@ impl BoundGrid {
         if !(u0.x >= 0.0 && u0.y >= 0.0 && u1.x <= n && u1.y <= n && u0.x <= u1.x && u0.y <= u1.y) {
             return None;
         }
-        // The finest level at which the box spans at most two cells per axis.
-        let span = (u1 - u0).max_element().max(1.0);
-        let mut k = (span.log2().ceil() as usize).min(self.levels.len() - 1);
-        let scale = (1usize << k) as f64;
-        let size = self.n >> k;
-        let clampi = |x: f64| (x / scale).floor().clamp(0.0, size as f64 - 1.0) as usize;
-        let (mut i0, mut i1, mut j0, mut j1) =
-            (clampi(u0.x), clampi(u1.x), clampi(u0.y), clampi(u1.y));
-        if i1 > i0 + 1 || j1 > j0 + 1 {
-            // log2 rounding: one level up always covers it.
-            k = (k + 1).min(self.levels.len() - 1);
+        // The cells of level k that the box touches: (i0, i1, j0, j1).
+        let cells = |k: usize| {
             let scale = (1usize << k) as f64;
             let size = self.n >> k;
             let c = |x: f64| (x / scale).floor().clamp(0.0, size as f64 - 1.0) as usize;
-            (i0, i1, j0, j1) = (c(u0.x), c(u1.x), c(u0.y), c(u1.y));
+            (c(u0.x), c(u1.x), c(u0.y), c(u1.y))
+        };
+        // The finest level at which the box spans at most two cells per axis.
+        let span = (u1 - u0).max_element().max(1.0);
+        let mut k = (span.log2().ceil() as usize).min(self.levels.len() - 1);
+        let (mut i0, mut i1, mut j0, mut j1) = cells(k);
+        if i1 > i0 + 1 || j1 > j0 + 1 {
+            // log2 rounding: one level up always covers it.
+            k = (k + 1).min(self.levels.len() - 1);
+            (i0, i1, j0, j1) = cells(k);
         }
         let size = self.n >> k;
         let level = &self.levels[k];
