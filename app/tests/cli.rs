@@ -78,6 +78,12 @@ fn run_measured(args: &[&str], limit: std::time::Duration) -> Measured {
 fn assert_refused(args: &[&str], says: &str) {
     let m = run_measured(args, std::time::Duration::from_secs(30));
     let err = String::from_utf8_lossy(&m.out.stderr);
+    eprintln!(
+        "refused in {:.0} ms, peak {} MiB: {}",
+        m.took.as_secs_f64() * 1e3,
+        m.peak_bytes >> 20,
+        args.join(" ").chars().take(120).collect::<String>()
+    );
     assert_eq!(m.out.status.code(), Some(2), "{args:?}: {err}");
     assert!(err.contains(says), "{args:?} should say {says:?}: {err}");
     assert!(
