@@ -41,6 +41,31 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Which term carries the filtered model's error: the far patch of `eval` for the material and
+    /// for variants with one term switched off in the model and the ground truth alike (diffuse
+    /// only, specular only, diffuse in constant grey, sun or environment alone), at every
+    /// combination of the listed view and light angles.
+    Diagnose {
+        /// View angles from the normal, degrees (0 to 89.5), comma-separated.
+        #[arg(long, default_value = "0,45,75", value_delimiter = ',', value_parser = view_angle)]
+        view_deg: Vec<f64>,
+        /// Light angles from the normal, degrees (0 to 180), comma-separated.
+        #[arg(long, default_value = "0,30", value_delimiter = ',', value_parser = light_angle)]
+        light_deg: Vec<f64>,
+        /// Light azimuths, degrees (the view's is 0: 0 puts the light on the viewer's side, 180
+        /// opposite), comma-separated.
+        #[arg(long, default_value = "0,180", value_delimiter = ',', value_parser = azimuth)]
+        light_azimuth_deg: Vec<f64>,
+        /// Sample the truth until its relative standard error is below this (0.0001 to 0.5).
+        #[arg(long, default_value_t = 0.005, value_parser = precision)]
+        precision: f64,
+        /// At most this many ground-truth rays per variant and configuration (2 to 10⁸).
+        #[arg(long, default_value_t = 2_000_000, value_parser = eval_samples)]
+        max_spp: usize,
+        /// Print JSON instead of a table.
+        #[arg(long)]
+        json: bool,
+    },
     /// Render the plane scene under one mode (or all of them) to PNG (8-bit sRGB) or EXR (linear).
     Render {
         /// naive, view-independent, filtered, truth, error (filtered against truth) or all.
@@ -257,6 +282,11 @@ fn number_in(s: &str, lo: f64, hi: f64, what: &str) -> Result<f64, String> {
         return Err(format!("{what} must be between {lo} and {hi}, got {s}"));
     }
     Ok(v)
+}
+
+/// A relative standard error to reach, 0.0001 to 0.5.
+fn precision(s: &str) -> Result<f64, String> {
+    number_in(s, 1e-4, 0.5, "relative standard error")
 }
 
 /// A camera angle from the normal: 0 to [`Camera::MAX_ELEVATION_DEG`] (89.5) degrees.

@@ -17,6 +17,7 @@ macro_rules! outln {
 mod chart;
 mod cielab;
 mod cli;
+mod diagnose;
 mod editor;
 mod eval;
 mod inspect;
@@ -183,6 +184,28 @@ fn run(cli: Cli) -> Result<()> {
                 outln!("{}", serde_json::to_string_pretty(&r)?);
             } else {
                 out!("{}", eval::table(&r));
+            }
+        }
+        Some(Command::Diagnose {
+            view_deg,
+            light_deg,
+            light_azimuth_deg,
+            precision,
+            max_spp,
+            json,
+        }) => {
+            let rows = diagnose::diagnose(
+                &preset,
+                &view_deg,
+                &light_deg,
+                &light_azimuth_deg,
+                precision,
+                max_spp,
+            )?;
+            if json {
+                outln!("{}", serde_json::to_string_pretty(&rows)?);
+            } else {
+                out!("{}", diagnose::table(&preset.material.name, &rows));
             }
         }
         Some(Command::Render {

@@ -850,3 +850,48 @@ fn hostile_presets_are_refused_in_bounded_time_and_memory() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `diagnose` splits the far patch's error by term: one row per variant and configuration, the
+/// diffuse and specular rows' truths adding up to the full one.
+#[test]
+fn diagnose_splits_the_error_by_term() {
+    let out = lodestone(&[
+        "--preset",
+        concat!(env!("CARGO_MANIFEST_DIR"), "/../presets/bumpy-specular.ron"),
+        "diagnose",
+        "--view-deg",
+        "45",
+        "--light-deg",
+        "30",
+        "--light-azimuth-deg",
+        "0,180",
+        "--max-spp",
+        "4000",
+        "--json",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let rows = rows.as_array().expect("rows");
+    assert_eq!(rows.len(), 2 * 4, "{rows:?}");
+    for config in rows.chunks(4) {
+        let names: Vec<_> = config
+            .iter()
+            .map(|r| r["variant"].as_str().unwrap())
+            .collect();
+        assert_eq!(
+            names,
+            ["full", "diffuse only", "specular only", "diffuse, grey"]
+        );
+        let t = |i: usize, k: usize| config[i]["truth"][k].as_f64().unwrap();
+        for k in 0..3 {
+            assert!(
+                (t(1, k) + t(2, k) - t(0, k)).abs() < 1e-9 * t(0, k),
+                "{config:?}"
+            );
+        }
+    }
+}
