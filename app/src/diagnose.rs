@@ -46,6 +46,9 @@ pub struct Row {
     pub share: f64,
     /// Ground-truth rays.
     pub samples: usize,
+    /// The prototype mixture model's relative error where it applies (diffuse, sun, colour map:
+    /// [`lodestone_core::eval::Evaluator::filtered_mixture`]).
+    pub mixture_error: Option<[f64; 3]>,
     /// Whether |filtered − truth| exceeds three standard errors in some channel.
     pub significant: bool,
 }
@@ -166,6 +169,9 @@ pub fn diagnose(
                         relative_error: [0, 1, 2].map(|k| of(fi[k] - gt.mean[k], gt.mean[k])),
                         share: (0..3).map(|k| of(gt.mean[k], full[k])).sum::<f64>() / 3.0,
                         samples: gt.samples,
+                        mixture_error: p
+                            .filtered_mixture(&cfg)
+                            .map(|v| [0, 1, 2].map(|k| of(v[k] - gt.mean[k], gt.mean[k]))),
                         significant: (0..3)
                             .any(|k| (fi[k] - gt.mean[k]).abs() > 3.0 * gt.std_error[k]),
                     });
@@ -190,8 +196,16 @@ pub fn table(material: &str, rows: &[Row]) -> String {
     };
     let mut s = format!(
         "{material}: filtered − truth per channel (R G B, %), far patch; * beyond 3 s.e.\n\
-         {:<5} {:<13} {:<16} {:>6} {:>21} {:>21} {:>7} {:>8}\n",
-        "view", "light", "variant", "share", "of itself", "of the full truth", "s.e.%", "rays"
+         {:<5} {:<13} {:<16} {:>6} {:>21} {:>21} {:>7} {:>8}  {:>21}\n",
+        "view",
+        "light",
+        "variant",
+        "share",
+        "of itself",
+        "of the full truth",
+        "s.e.%",
+        "rays",
+        "mixture (prototype)"
     );
     for r in rows {
         let se = (0..3)
@@ -203,8 +217,9 @@ pub fn table(material: &str, rows: &[Row]) -> String {
             pct(r.relative_error)
         };
         let of_full = r.error_of_full.map_or_else(|| "—".to_string(), pct);
+        let mixture = r.mixture_error.map_or_else(String::new, pct);
         s += &format!(
-            "{:<5} {:<13} {:<16} {:>5.0}% {:>21} {:>21} {:>7.2} {:>8}{}\n",
+            "{:<5} {:<13} {:<16} {:>5.0}% {:>21} {:>21} {:>7.2} {:>8}{:2} {:>21}\n",
             format!("{}°", r.view_deg),
             format!("{}° az {}°", r.light_deg, r.light_azimuth_deg),
             r.variant,
@@ -213,7 +228,8 @@ pub fn table(material: &str, rows: &[Row]) -> String {
             of_full,
             se,
             r.samples,
-            if r.significant { " *" } else { "" }
+            if r.significant { " *" } else { "" },
+            mixture
         );
     }
     s

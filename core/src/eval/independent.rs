@@ -66,8 +66,11 @@ fn check(name: &str, m: &Material, views: &[f64], tol: impl Fn(f64) -> f64, samp
         let fi = p.filtered(&cfg);
         let (over, rel) = excess(fi, &gt);
         worst = worst.max(rel.iter().fold(0.0f64, |a, r| a.max(r.abs())));
+        let mixture = p
+            .filtered_mixture(&cfg)
+            .map(|v| [0, 1, 2].map(|k| 100.0 * (v[k] - gt.mean[k]) / gt.mean[k]));
         eprintln!(
-            "{name}, {deg}°, {light}: filtered − truth {:+.2?}%",
+            "{name}, {deg}°, {light}: filtered − truth {:+.2?}%, mixture {mixture:+.2?}%",
             rel.map(|r| 100.0 * r)
         );
         if over > tol(deg) {

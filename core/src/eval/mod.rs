@@ -33,6 +33,7 @@ pub mod evaluator;
 pub mod filtered;
 pub mod ground_truth;
 pub mod lod_surface;
+pub mod mixture;
 pub mod naive;
 pub mod pixel;
 pub mod query;
