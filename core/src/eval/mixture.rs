@@ -1,4 +1,5 @@
-//! Prototype (#17): the diffuse term of the filtered model as a mixture over the driver's value.
+//! Prototype (#17): the filtered model (diffuse and specular, sun) as a mixture over the driver's
+//! value.
 //!
 //! For a Gaussian driver f ~ N(f̄, σ_f²) over the footprint, the value and the gradient of f at a
 //! point are independent, so the transformed surface h = σ_h·g(f) has, given f, Gaussian slopes
@@ -11,18 +12,21 @@
 //! (with slopes independent of height this is Φ(z)^Λ, the usual form). View and light combine per
 //! z′ as in [`G2::new`]. The diffuse radiance per visible projected area is then
 //!
-//! `I = (ρ/π)·E_sun·Σ_j w_j C_j G2(z_j) S_j / Σ_j w_j G1o(z_j) So_j`
+//! `I = E_sun·Σ_j w_j G2(z_j) ((ρ/π)·C_j S_j + So_j ρ_s,j) / Σ_j w_j G1o(z_j) So_j`
 //!
-//! with `S_j = E[⟨ωo·m⟩⁺/m_z·⟨ωi·m⟩⁺]` and `So_j = E[⟨ωo·m⟩⁺/m_z]` over node j's slopes
+//! with `S_j = E[⟨ωo·m⟩⁺/m_z·⟨ωi·m⟩⁺]` and `So_j = E[⟨ωo·m⟩⁺/m_z]` over node j's slopes, and
+//! ρ_s,j the widened specular lobe of node j's slopes per unit of their visible area
+//! ([`filtered_specular`])
 //! ([`visible_slope_nodes`]). Far field, plane, sun only, a colour map (driver or height source)
-//! or the HN12 attribute at the point's standardized height (clamped at 0), without colour terms
-//! or specular; `None` otherwise. CPU only: compared with the ground truth by
+//! or the HN12 attribute at the point's standardized height (clamped at 0), without colour
+//! terms; `None` otherwise. CPU only: compared with the ground truth by
 //! `lodestone diagnose` before the model adopts it.
 
 use crate::eval::{Evaluator, FootprintQuery};
 use crate::material::{ColorModel, ColorSource};
 use crate::math::special::{norm_cdf, norm_pdf};
 use crate::microfacet::attribute::attribute;
+use crate::microfacet::brdf::filtered_specular;
 use crate::microfacet::masking_shadowing::{G2, azimuth_difference};
 use crate::microfacet::smith::lambda;
 use crate::microfacet::visible_slopes::visible_slope_nodes;
@@ -37,10 +41,7 @@ impl Evaluator {
     /// prototype does not apply.
     pub fn filtered_mixture(&self, cfg: &FootprintQuery) -> Option<[f64; 3]> {
         let m = &self.material;
-        if m.lighting.environment.is_some()
-            || m.terms.slope.is_some()
-            || m.terms.constant.is_some()
-            || m.brdf.specular > 0.0
+        if m.lighting.environment.is_some() || m.terms.slope.is_some() || m.terms.constant.is_some()
         {
             return None;
         }
@@ -79,6 +80,7 @@ impl Evaluator {
             l_total: f64,
             s: f64,
             s_o: f64,
+            spec: f64,
         }
         let nodes: Vec<Node> = zs
             .iter()
@@ -100,7 +102,9 @@ impl Evaluator {
                         s += w * n.dot(wi).max(0.0);
                     }
                 });
+                let b = &m.brdf;
                 Node {
+                    spec: filtered_specular(b.specular, b.roughness, mean, &cov, wo, wi),
                     w: weight_of(z) / total,
                     color: color_of(f),
                     l_o: ms.lambda_o,
@@ -112,7 +116,7 @@ impl Evaluator {
             .collect();
         // G(z_j) = exp(−Σ_{i>j} Λ_i w_i/Φ(z_i) − ½Λ_j w_j/Φ(z_j)): the integral from the top down.
         let (mut acc_o, mut acc) = (0.0, 0.0);
-        let (mut num, mut den) = ([0.0f64; 3], 0.0f64);
+        let (mut num, mut den, mut spec) = ([0.0f64; 3], 0.0f64, 0.0f64);
         for (j, node) in nodes.iter().enumerate().rev() {
             let phi = norm_cdf(zs[j]).max(1e-300);
             let (half_o, half) = (
@@ -123,6 +127,8 @@ impl Evaluator {
             acc_o += 2.0 * half_o;
             acc += 2.0 * half;
             den += node.w * g1 * node.s_o;
+            // The node's lobe per unit of its visible area (filtered_specular divides by So_j).
+            spec += node.w * g2 * node.s_o * node.spec;
             for k in 0..3 {
                 num[k] += node.w * node.color[k] * g2 * node.s;
             }
@@ -131,7 +137,8 @@ impl Evaluator {
             return Some([0.0; 3]);
         }
         let kd = m.brdf.albedo * FRAC_1_PI * m.lighting.sun;
-        Some(num.map(|v| kd * v / den))
+        let ks = m.lighting.sun * spec / den;
+        Some(num.map(|v| kd * v / den + ks))
     }
 }
 
