@@ -895,3 +895,44 @@ fn diagnose_splits_the_error_by_term() {
         }
     }
 }
+
+/// The README's `eval` example is what `eval` prints today (#17: it showed 0.51% for a command
+/// that printed 5.72%). `UPDATE_README=1` rewrites the block from the command's output.
+#[test]
+fn the_readme_eval_example_is_current() {
+    let readme_path = concat!(env!("CARGO_MANIFEST_DIR"), "/../README.md");
+    let readme = std::fs::read_to_string(readme_path).expect("README.md");
+    let intro = "`eval` reports the mean linear-RGB colour";
+    let start = readme.find(intro).expect("the eval paragraph");
+    let open = start + readme[start..].find("```\n").expect("its example") + 4;
+    let close = open + readme[open..].find("```").expect("the end of the example");
+    let block = &readme[open..close];
+    let out = lodestone(&[
+        "eval",
+        "--view-deg",
+        "75",
+        "--light-deg",
+        "0",
+        "--spp",
+        "40000",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let printed = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        block.starts_with("Rusty bumps — view 75° (azimuth 0°), light 0° (azimuth 0°), 40000"),
+        "the example's command changed: {block}"
+    );
+    if std::env::var("UPDATE_README").is_ok_and(|v| !v.is_empty() && v != "0") {
+        let updated = format!("{}{printed}{}", &readme[..open], &readme[close..]);
+        std::fs::write(readme_path, updated).expect("write README.md");
+        return;
+    }
+    assert_eq!(
+        block, printed,
+        "README's eval example is stale: rerun with UPDATE_README=1"
+    );
+}
