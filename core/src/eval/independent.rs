@@ -239,3 +239,92 @@ fn cylinder_filters_to_ground_truth() {
         );
     }
 }
+
+/// Why the specular lobe is off in the slope distribution's tails (#17, bumpy-specular): the
+/// density of the noise's slopes (σ_h ∇f of a sum of sinusoids, phases uniform: the footprint's
+/// statistics far away) at the half vectors of the failing configurations, by Monte Carlo over the
+/// phases, against the Gaussian of the same covariance that the filtered lobe uses. Measurement
+/// (`cargo test -- --ignored`), printed.
+#[test]
+#[ignore = "a measurement for the closing note, prints a table"]
+fn slope_density_of_the_noise_in_its_tails() {
+    use crate::microfacet::slopes::slope_of;
+    let text = std::fs::read_to_string(format!(
+        "{}/../presets/bumpy-specular.ron",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .expect("preset");
+    let m = Material::from_ron(&text).expect("valid");
+    let noise = m.noise().expect("a noise driver");
+    let sh = m.heights.sigma_h;
+    // Slope contributions c_i k̂_i sin ψ_i, c_i = σ_h 2π a_i |k_i|.
+    let terms: Vec<(f64, DVec2)> = noise
+        .waves
+        .iter()
+        .map(|w| {
+            (
+                sh * 2.0 * PI * w.amplitude * w.k.length(),
+                w.k.normalize_or_zero(),
+            )
+        })
+        .collect();
+    let (mut xx, mut yy, mut xy) = (0.0, 0.0, 0.0);
+    for (c, d) in &terms {
+        xx += 0.5 * c * c * d.x * d.x;
+        yy += 0.5 * c * c * d.y * d.y;
+        xy += 0.5 * c * c * d.x * d.y;
+    }
+    let det = xx * yy - xy * xy;
+    let gauss = |s: DVec2| {
+        let q = (yy * s.x * s.x - 2.0 * xy * s.x * s.y + xx * s.y * s.y) / det;
+        (-0.5 * q).exp() / (2.0 * PI * det.sqrt())
+    };
+    let max_slope: f64 = terms.iter().map(|(c, _)| c.abs()).sum();
+    eprintln!(
+        "σ_n {:.3} {:.3}, slopes bounded by Σ c_i = {max_slope:.2}",
+        xx.sqrt(),
+        yy.sqrt()
+    );
+    let configs = [
+        ("45° / 30° same side", 45.0, 30.0, 0.0),
+        ("75° / 30° same side", 75.0, 30.0, 0.0),
+        ("85° / 30° opposite", 85.0, 30.0, 180.0),
+        ("45° / 60° opposite", 45.0, 60.0, 180.0),
+        ("60° / 0°", 60.0, 0.0, 0.0),
+    ];
+    let samples = 20_000_000u64;
+    let r = 0.03;
+    let mut counts = vec![0u64; configs.len()];
+    let centres: Vec<DVec2> = configs
+        .iter()
+        .map(|(_, v, l, az)| {
+            let wo = direction(f64::to_radians(*v), 0.0);
+            let wi = direction(f64::to_radians(*l), f64::to_radians(*az));
+            slope_of((wo + wi).normalize())
+        })
+        .collect();
+    let mut rng = 0x1234_5678_u64;
+    for _ in 0..samples {
+        let mut s = DVec2::ZERO;
+        for (c, d) in &terms {
+            let psi = 2.0 * PI * crate::math::random::splitmix(&mut rng);
+            s += *d * (c * psi.sin());
+        }
+        for (i, c) in centres.iter().enumerate() {
+            if (s - *c).length_squared() < r * r {
+                counts[i] += 1;
+            }
+        }
+    }
+    for (i, (name, ..)) in configs.iter().enumerate() {
+        let exact = counts[i] as f64 / (samples as f64 * PI * r * r);
+        let g = gauss(centres[i]);
+        let sigmas = (centres[i].length_squared() / xx).sqrt();
+        eprintln!(
+            "{name:22} half-vector slope {:.3} ({sigmas:.1}σ): noise density {exact:.4e} ({} hits), Gaussian {g:.4e}, ratio {:.3}",
+            centres[i].length(),
+            counts[i],
+            exact / g
+        );
+    }
+}
