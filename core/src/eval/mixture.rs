@@ -12,17 +12,20 @@
 //! (with slopes independent of height this is Φ(z)^Λ, the usual form). View and light combine per
 //! z′ as in [`G2::new`]. The diffuse radiance per visible projected area is then
 //!
-//! `I = E_sun·Σ_j w_j G2(z_j) ((ρ/π)·C_j S_j + So_j ρ_s,j) / Σ_j w_j G1o(z_j) So_j`
+//! `I = Σ_j w_j [G2(z_j)·E_sun((ρ/π)·C_j S_j + So_j ρ_s,j) + G1o(z_j)(ρ/π)·C_j S_env,j] / Σ_j w_j G1o(z_j) So_j`
 //!
 //! with `S_j = E[⟨ωo·m⟩⁺/m_z·⟨ωi·m⟩⁺]` and `So_j = E[⟨ωo·m⟩⁺/m_z]` over node j's slopes, and
 //! ρ_s,j the widened specular lobe of node j's slopes per unit of their visible area
-//! ([`filtered_specular`])
-//! ([`visible_slope_nodes`]). Far field, plane, sun only, a colour map (driver or height source)
-//! or the HN12 attribute at the point's standardized height (clamped at 0), without colour
-//! terms; `None` otherwise. CPU only: compared with the ground truth by
-//! `lodestone diagnose` before the model adopts it.
+//! ([`filtered_specular`], [`visible_slope_nodes`]). The colour terms (constant, slope colour)
+//! and the environment enter per node as in the model: `C_j` is the point colour's `A + K ⊙ C_s`,
+//! the environment is weighted by G1 (unshadowed), the sun by G2. Far field, plane; the colour
+//! map (driver or height source) or the HN12 attribute at the point's standardized height
+//! (clamped at 0). CPU only: compared with the ground truth by `lodestone diagnose` before the
+//! model adopts it.
 
+use crate::eval::shading::SlopeShading;
 use crate::eval::{Evaluator, FootprintQuery};
+use crate::material::color_terms::Affine;
 use crate::material::{ColorModel, ColorSource};
 use crate::math::special::{norm_cdf, norm_pdf};
 use crate::microfacet::attribute::attribute;
@@ -30,6 +33,7 @@ use crate::microfacet::brdf::filtered_specular;
 use crate::microfacet::masking_shadowing::{G2, azimuth_difference};
 use crate::microfacet::smith::lambda;
 use crate::microfacet::visible_slopes::visible_slope_nodes;
+use glam::DMat3;
 use std::f64::consts::FRAC_1_PI;
 
 /// Nodes of the driver's standardized value: z in [−Z_MAX, Z_MAX], step 2·Z_MAX/(NODES − 1).
@@ -37,16 +41,16 @@ const NODES: usize = 241;
 const Z_MAX: f64 = 6.0;
 
 impl Evaluator {
-    /// The diffuse term as a mixture over the driver's value (module docs), or `None` where the
-    /// prototype does not apply.
+    /// The filtered model as a mixture over the driver's value (module docs). `Some` always (an
+    /// `Option` so that a variant it cannot represent can say so).
     pub fn filtered_mixture(&self, cfg: &FootprintQuery) -> Option<[f64; 3]> {
         let m = &self.material;
-        if m.lighting.environment.is_some() || m.terms.slope.is_some() || m.terms.constant.is_some()
-        {
-            return None;
+        let (wo, wi) = (cfg.wo, cfg.wi);
+        if wo.z <= 0.0 {
+            return Some([0.0; 3]);
         }
         // The colour of a point with driver value f (t its standardized height), as the ground
-        // truth colours it ([`Evaluator::color_at`]).
+        // truth colours it ([`Evaluator::color_at`]), then the colour terms' A + K ⊙ C_s(n).
         let color_of = |f: f64| -> [f64; 3] {
             let (gm, gs) = self.global_height;
             let t = (m.heights.transfer.eval(f) - gm) / gs;
@@ -60,25 +64,22 @@ impl Evaluator {
                 }
             }
         };
-        let (wo, wi) = (cfg.wo, cfg.wi);
-        if wo.z <= 0.0 {
-            return Some([0.0; 3]);
-        }
         let loc = self.footprint_stats(cfg);
         let d = loc.driver;
         let sigma_h = self.surface.sigma_h;
-        let weight_of = |z: f64| norm_pdf(z);
         let dz = 2.0 * Z_MAX / (NODES - 1) as f64;
         let zs: Vec<f64> = (0..NODES).map(|j| -Z_MAX + dz * j as f64).collect();
-        let total: f64 = zs.iter().map(|&z| weight_of(z)).sum();
+        let total: f64 = zs.iter().map(|&z| norm_pdf(z)).sum();
         let points = m.filtering.slope_points as usize;
         let dphi = azimuth_difference(wo, wi);
+        let sun_up = wi.z > 0.0;
         struct Node {
             w: f64,
-            color: [f64; 3],
+            color: Affine,
             l_o: f64,
             l_total: f64,
-            s: f64,
+            // Unnormalized visible-slope sums: the shading inputs weighted by ⟨ωo·m⟩⁺/m_z.
+            shading: SlopeShading,
             s_o: f64,
             spec: f64,
         }
@@ -95,50 +96,67 @@ impl Evaluator {
                     dphi,
                     m.filtering.correlation,
                 );
-                let (mut s, mut s_o) = (0.0, 0.0);
+                let mut acc = SlopeShading::default();
+                let mut s_o = 0.0;
                 visible_slope_nodes(mean, &cov, wo, points, |n, w| {
                     s_o += w;
-                    if wi.z > 0.0 {
-                        s += w * n.dot(wi).max(0.0);
+                    let p = self.point_shading(n, wi, &DMat3::IDENTITY);
+                    if sun_up {
+                        acc.cos += w * p.cos;
+                    }
+                    for c in 0..3 {
+                        if sun_up {
+                            acc.cs_cos[c] += w * p.cs_cos[c];
+                        }
+                        acc.env[c] += w * p.env[c];
+                        acc.cs_env[c] += w * p.cs_env[c];
                     }
                 });
                 let b = &m.brdf;
                 Node {
-                    spec: filtered_specular(b.specular, b.roughness, mean, &cov, wo, wi),
-                    w: weight_of(z) / total,
-                    color: color_of(f),
+                    w: norm_pdf(z) / total,
+                    color: m.terms.affine(color_of(f)),
                     l_o: ms.lambda_o,
                     l_total: ms.total,
-                    s,
+                    shading: acc,
                     s_o,
+                    spec: filtered_specular(b.specular, b.roughness, mean, &cov, wo, wi),
                 }
             })
             .collect();
         // G(z_j) = exp(−Σ_{i>j} Λ_i w_i/Φ(z_i) − ½Λ_j w_j/Φ(z_j)): the integral from the top down.
+        let kd = m.brdf.albedo * FRAC_1_PI;
+        let sun = m.lighting.sun;
         let (mut acc_o, mut acc) = (0.0, 0.0);
-        let (mut num, mut den, mut spec) = ([0.0f64; 3], 0.0f64, 0.0f64);
+        let (mut num, mut den) = ([0.0f64; 3], 0.0f64);
         for (j, node) in nodes.iter().enumerate().rev() {
             let phi = norm_cdf(zs[j]).max(1e-300);
             let (half_o, half) = (
                 0.5 * node.l_o * node.w / phi,
                 0.5 * node.l_total * node.w / phi,
             );
+            // Visible (G1) for the unshadowed environment, visible and lit (G2) for the sun.
             let (g1, g2) = ((-(acc_o + half_o)).exp(), (-(acc + half)).exp());
             acc_o += 2.0 * half_o;
             acc += 2.0 * half;
             den += node.w * g1 * node.s_o;
-            // The node's lobe per unit of its visible area (filtered_specular divides by So_j).
-            spec += node.w * g2 * node.s_o * node.spec;
-            for k in 0..3 {
-                num[k] += node.w * node.color[k] * g2 * node.s;
+            let (a, k, sh) = (node.color.a, node.color.k, &node.shading);
+            for c in 0..3 {
+                let sun_part = sun * (a[c] * sh.cos + k[c] * sh.cs_cos[c]);
+                let env_part = a[c] * sh.env[c] + k[c] * sh.cs_env[c];
+                // The node's lobe per unit of its visible area (filtered_specular divides by So).
+                let spec = if sun_up {
+                    sun * node.s_o * node.spec
+                } else {
+                    0.0
+                };
+                num[c] += node.w * (g2 * (kd * sun_part + spec) + g1 * kd * env_part);
             }
         }
         if !(den > 0.0) {
             return Some([0.0; 3]);
         }
-        let kd = m.brdf.albedo * FRAC_1_PI * m.lighting.sun;
-        let ks = m.lighting.sun * spec / den;
-        Some(num.map(|v| kd * v / den + ks))
+        Some(num.map(|v| v / den))
     }
 }
 
@@ -300,7 +318,8 @@ mod tests {
     }
 
     /// With the identity transfer the slopes do not depend on f: the mixture is one Gaussian and
-    /// reproduces the filtered model (to its quadrature), colour map and HN12 attribute alike.
+    /// reproduces the filtered model (to its quadrature): colour map, HN12 attribute, and specular
+    /// with the sky and a slope colour.
     #[test]
     fn with_the_identity_transfer_it_is_the_filtered_model() {
         let mut attribute = gaussian_material();
@@ -308,7 +327,22 @@ mod tests {
             mean: [0.4, 0.25, 0.1],
             correlation: [0.2, 0.1, -0.05],
         };
-        for m in [gaussian_material(), attribute] {
+        // Specular, the sky and a slope colour multiplying the height colour.
+        let mut lit = gaussian_material();
+        lit.brdf.specular = 0.04;
+        lit.brdf.roughness = 0.15;
+        lit.lighting.environment = Some(crate::material::environment::Environment {
+            source: crate::material::environment::EnvironmentSource::Sky(
+                crate::material::environment::Sky::default(),
+            ),
+            intensity: 0.7,
+        });
+        lit.terms.mode = crate::material::color_terms::CombineMode::Multiplicative;
+        lit.terms.slope = Some(crate::material::color_terms::SlopeTerm {
+            color: crate::material::slope_color::SlopeColor::snow(),
+            weight: 0.8,
+        });
+        for m in [gaussian_material(), attribute, lit] {
             let p = Evaluator::new(&m).expect("valid");
             for (deg, wi) in [
                 (0.0, DVec3::Z),
