@@ -62,6 +62,9 @@ pub enum Command {
         /// At most this many ground-truth rays per variant and configuration (2 to 10⁸).
         #[arg(long, default_value_t = 2_000_000, value_parser = eval_samples)]
         max_spp: usize,
+        /// Only the material itself, no variants (an accuracy grid over many configurations).
+        #[arg(long)]
+        full_only: bool,
         /// Print JSON instead of a table.
         #[arg(long)]
         json: bool,

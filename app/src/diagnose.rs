@@ -122,18 +122,36 @@ fn truth(
     }
 }
 
-/// Diagnose the far patch at every (view, light, light azimuth) combination.
+/// The configurations: every combination of view angle, light angle and light azimuth (degrees;
+/// the view's azimuth is 0).
+#[derive(Clone, Copy, Debug)]
+pub struct Grid<'a> {
+    /// View angles from the normal.
+    pub views: &'a [f64],
+    /// Light angles from the normal.
+    pub lights: &'a [f64],
+    /// Light azimuths.
+    pub azimuths: &'a [f64],
+}
+
+/// Diagnose the far patch at every configuration of `grid` (only the material itself with
+/// `full_only`).
 pub fn diagnose(
     preset: &Resolved,
-    views: &[f64],
-    lights: &[f64],
-    azimuths: &[f64],
+    grid: &Grid,
     precision: f64,
     max_samples: usize,
+    full_only: bool,
 ) -> Result<Vec<Row>> {
+    let Grid {
+        views,
+        lights,
+        azimuths,
+    } = *grid;
     let mut rows = vec![];
     let prepared: Vec<_> = variants(&preset.material)
         .into_iter()
+        .take(if full_only { 1 } else { usize::MAX })
         .map(|(name, material)| {
             let r = Resolved {
                 material,
@@ -257,7 +275,19 @@ mod tests {
             ["full", "diffuse only", "specular only", "diffuse, grey"]
         );
         let preset = Resolved::without_image(m);
-        let rows = diagnose(&preset, &[45.0], &[30.0], &[0.0], 1.0, 4000).expect("diagnose");
+        let grid = Grid {
+            views: &[45.0],
+            lights: &[30.0],
+            azimuths: &[0.0],
+        };
+        let rows = diagnose(&preset, &grid, 1.0, 4000, false).expect("diagnose");
+        assert_eq!(
+            diagnose(&preset, &grid, 1.0, 4000, true)
+                .expect("diagnose")
+                .len(),
+            1,
+            "--full-only: the material alone"
+        );
         let get = |n: &str| rows.iter().find(|r| r.variant == n).expect(n);
         let (full, d, s) = (get("full"), get("diffuse only"), get("specular only"));
         for k in 0..3 {

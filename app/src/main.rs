@@ -192,15 +192,19 @@ fn run(cli: Cli) -> Result<()> {
             light_azimuth_deg,
             precision,
             max_spp,
+            full_only,
             json,
         }) => {
             let rows = diagnose::diagnose(
                 &preset,
-                &view_deg,
-                &light_deg,
-                &light_azimuth_deg,
+                &diagnose::Grid {
+                    views: &view_deg,
+                    lights: &light_deg,
+                    azimuths: &light_azimuth_deg,
+                },
                 precision,
                 max_spp,
+                full_only,
             )?;
             if json {
                 outln!("{}", serde_json::to_string_pretty(&rows)?);
