@@ -13,7 +13,7 @@ use crate::microfacet::effective_height::height_moments;
 use crate::microfacet::masking_shadowing::G2;
 use crate::microfacet::slopes::normal_of;
 use crate::scene::direction::basis;
-use glam::{DMat3, DVec3};
+use glam::{DMat3, DVec2, DVec3};
 
 impl Evaluator {
     /// The filtered model (see the module docs).
@@ -33,10 +33,14 @@ impl Evaluator {
         let nbar = normal_of(loc.stats.slope_mean);
         let (t, b) = basis(nbar);
         let to_local = |w: DVec3| DVec3::new(w.dot(t), w.dot(b), w.dot(nbar));
-        let (wo, wi) = (to_local(cfg.wo), to_local(cfg.wi));
-        if wo.z <= 0.0 || cfg.wo.z <= 0.0 {
+        if cfg.wo.z <= 0.0 {
             return [0.0; 3];
         }
+        // The footprint's resolved slope can tilt its mean plane away from a grazing view the
+        // ray still meets (image drivers at the horizon): the view then grazes the mean plane,
+        // kept just above its horizon so that the result is continuous across the tilt instead
+        // of black ([`above_horizon`]).
+        let (wo, wi) = (above_horizon(to_local(cfg.wo)), to_local(cfg.wi));
         let sigma = loc.stats.slope_cov;
         let f = &self.material.filtering;
         let ms = G2::from_directions(wo, wi, &sigma, f.correlation);
@@ -66,5 +70,80 @@ impl Evaluator {
         let shading = self.visible_shading(mean, &sigma, cfg.wo, cfg.wi, frame);
         let spec = filtered_specular(brdf.specular, brdf.roughness, mean, &sigma, cfg.wo, cfg.wi);
         self.radiance(sun_color, env_color, &shading, sun_visible * vbar, spec)
+    }
+}
+
+/// Lowest cosine a view keeps to the footprint's mean plane: `ω` with `ω_z` raised to it and
+/// its horizontal part shortened to stay unit (unchanged above it).
+pub const MIN_VIEW_COS: f64 = 1e-3;
+
+/// `ω` (unit, tangent frame) kept at least [`MIN_VIEW_COS`] above the horizon.
+pub fn above_horizon(w: DVec3) -> DVec3 {
+    if w.z >= MIN_VIEW_COS {
+        return w;
+    }
+    let h = DVec2::new(w.x, w.y);
+    let len = h.length();
+    let scale = (1.0 - MIN_VIEW_COS * MIN_VIEW_COS).sqrt();
+    let h = if len > 0.0 {
+        h * (scale / len)
+    } else {
+        DVec2::new(scale, 0.0)
+    };
+    DVec3::new(h.x, h.y, MIN_VIEW_COS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::driver::footprint::Footprint;
+    use crate::eval::{Evaluator, FootprintQuery};
+    use crate::material::{Material, Slopes};
+    use crate::scene::direction::direction;
+    use glam::DVec2;
+
+    /// A small footprint on steep relief seen at 89°: where its mean plane faces away from the
+    /// view, the filtered model used to return black while the naive view (and the ray) saw
+    /// the surface; now it is finite, positive, and close to its value just before the flip.
+    #[test]
+    fn a_mean_plane_tilted_away_from_the_view_is_not_black() {
+        let m = Material {
+            slopes: Slopes {
+                sigma_nx: 1.5,
+                sigma_ny: 1.5,
+            },
+            ..Material::default()
+        };
+        let p = Evaluator::new(&m).expect("valid");
+        let (mut flipped, mut rng) = (0, 7u64);
+        for _ in 0..400 {
+            let x0 = DVec2::new(
+                20.0 * crate::math::random::splitmix(&mut rng),
+                20.0 * crate::math::random::splitmix(&mut rng),
+            );
+            let az = std::f64::consts::TAU * crate::math::random::splitmix(&mut rng);
+            let cfg = FootprintQuery {
+                wo: direction(89f64.to_radians(), az),
+                wi: direction(0.5, 1.0),
+                x0,
+                footprint: Footprint::isotropic(0.02),
+            };
+            let loc = p.footprint_stats(&cfg);
+            let nbar = normal_of(loc.stats.slope_mean);
+            if cfg.wo.dot(nbar) <= 0.0 {
+                flipped += 1;
+                let (fi, na) = (p.filtered(&cfg), p.naive(&cfg));
+                assert!(fi.iter().all(|v| v.is_finite() && *v >= 0.0), "{fi:?}");
+                assert!(
+                    na.iter().sum::<f64>() <= 0.0 || fi.iter().sum::<f64>() > 0.0,
+                    "black where naive is {na:?}"
+                );
+            }
+        }
+        assert!(flipped > 10, "the test needs tilted footprints: {flipped}");
+        // Continuity: just below and just above the horizon of a unit frame agree.
+        let a = above_horizon(DVec3::new(1.0, 0.0, -1e-6).normalize());
+        let b = above_horizon(DVec3::new(1.0, 0.0, 1e-6).normalize());
+        assert!((a - b).length() < 1e-9 && (a.length() - 1.0).abs() < 1e-12);
     }
 }

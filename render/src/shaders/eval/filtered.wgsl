@@ -8,11 +8,12 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
     let nbar = normal_of(loc.stats.slope_mean);
     let t = basis_t(nbar);
     let b = basis_b(nbar);
-    let wo = vec3<f32>(dot(wo_w, t), dot(wo_w, b), dot(wo_w, nbar));
-    let wi = vec3<f32>(dot(wi_w, t), dot(wi_w, b), dot(wi_w, nbar));
-    if (wo.z <= 0.0 || wo_w.z <= 0.0) {
+    if (wo_w.z <= 0.0) {
         return vec3<f32>(0.0);
     }
+    // A mean plane tilted away from a grazing view the ray still meets: the view grazes it.
+    let wo = above_horizon(vec3<f32>(dot(wo_w, t), dot(wo_w, b), dot(wo_w, nbar)));
+    let wi = vec3<f32>(dot(wi_w, t), dot(wi_w, b), dot(wi_w, nbar));
     let cov = loc.stats.slope_cov;
     let ms = masking_shadowing(wo, wi, cov);
     let d = input_distribution(loc);
@@ -47,4 +48,19 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
     let spec = filtered_specular(vec2<f32>(0.0), vec3<f32>(0.0), wo_w, wi_w);
     return radiance(aff, aff, point_shading(vec3<f32>(0.0, 0.0, 1.0), wi_w), sun_visible * select(0.0, 1.0, wi_w.z > 0.0), spec);
 //#endif
+}
+
+// above_horizon: ω kept at least MIN_VIEW_COS above the mean plane's horizon.
+const MIN_VIEW_COS: f32 = 1e-3;
+fn above_horizon(w: vec3<f32>) -> vec3<f32> {
+    if (w.z >= MIN_VIEW_COS) {
+        return w;
+    }
+    let len = length(w.xy);
+    let scale = sqrt(1.0 - MIN_VIEW_COS * MIN_VIEW_COS);
+    var h = vec2<f32>(scale, 0.0);
+    if (len > 0.0) {
+        h = w.xy * (scale / len);
+    }
+    return vec3<f32>(h, MIN_VIEW_COS);
 }
