@@ -9,7 +9,6 @@
 //! is known to be off (transfer curves, grazing views: issue #17) the bound is the measured error
 //! with a margin, so a regression (or a fix that should tighten it) shows.
 
-use crate::driver::footprint::Footprint;
 use crate::eval::test_materials::gaussian_material;
 use crate::eval::{Estimate, Evaluator, FootprintQuery, Method};
 use crate::material::transfer::{Curve, TransferFunction};
@@ -36,12 +35,7 @@ fn configs(views: &[f64]) -> Vec<(f64, &'static str, DVec3)> {
 }
 
 fn far(deg: f64, wi: DVec3) -> FootprintQuery {
-    FootprintQuery {
-        wo: direction(deg.to_radians(), 0.3),
-        wi,
-        x0: DVec2::new(3.0, -7.0),
-        footprint: Footprint::isotropic(40.0),
-    }
+    crate::eval::test_materials::far_patch(direction(deg.to_radians(), 0.3), wi)
 }
 
 /// Largest |filtered − truth| / truth − 3·se/truth over channels (≤ 0: within noise), and the

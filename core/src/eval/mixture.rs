@@ -300,21 +300,15 @@ impl Evaluator {
 
 #[cfg(test)]
 mod tests {
-    use crate::driver::footprint::Footprint;
     use crate::eval::test_materials::gaussian_material;
     use crate::eval::{Evaluator, FootprintQuery};
     use crate::material::transfer::{Curve, TransferFunction};
     use crate::material::{ColorModel, ColorSource};
     use crate::scene::direction::direction;
-    use glam::{DVec2, DVec3};
+    use glam::DVec3;
 
     fn far(deg: f64, wi: DVec3) -> FootprintQuery {
-        FootprintQuery {
-            wo: direction(deg.to_radians(), 0.3),
-            wi,
-            x0: DVec2::new(3.0, -7.0),
-            footprint: Footprint::isotropic(40.0),
-        }
+        crate::eval::test_materials::far_patch(direction(deg.to_radians(), 0.3), wi)
     }
 
     /// With the identity transfer the slopes do not depend on f: the mixture is one Gaussian and

@@ -36,3 +36,13 @@ pub(crate) fn gaussian_material() -> Material {
         ..Material::default()
     }
 }
+
+/// The far patch the evaluation tests share: a 40-unit isotropic footprint at (3, −7).
+pub(crate) fn far_patch(wo: glam::DVec3, wi: glam::DVec3) -> crate::eval::FootprintQuery {
+    crate::eval::FootprintQuery {
+        wo,
+        wi,
+        x0: glam::DVec2::new(3.0, -7.0),
+        footprint: crate::driver::footprint::Footprint::isotropic(40.0),
+    }
+}

@@ -5,15 +5,10 @@ use crate::eval::test_materials::gaussian_material;
 use crate::eval::{Evaluator, FootprintQuery};
 use crate::material::Slopes;
 use crate::scene::direction::direction;
-use glam::{DVec2, DVec3};
+use glam::DVec3;
 
 fn far(wo: DVec3, wi: DVec3) -> FootprintQuery {
-    FootprintQuery {
-        wo,
-        wi,
-        x0: DVec2::new(3.0, -7.0),
-        footprint: Footprint::isotropic(40.0),
-    }
+    crate::eval::test_materials::far_patch(wo, wi)
 }
 
 /// Slope colour (sun only), environment only, and both combined multiplicatively with the
