@@ -5,7 +5,8 @@
 //! averaged over the visible slope distribution D_s [HNPN14 Sec. 5.2] jointly with the slope colour
 //! and environment irradiance ([`crate::eval::shading`]), and ρ̄_s the Beckmann lobe widened by the
 //! unresolved slopes ([`filtered_specular`], [HN12 Sec. 5.5]). Transfer functions enter through their
-//! moment tables [HNPN14 Eqs. 21–26].
+//! moment tables [HNPN14 Eqs. 21–26]; under a transfer curve the slopes are by default a mixture
+//! over the driver's value instead of one Gaussian ([`crate::eval::mixture_bins`]).
 
 use crate::eval::{Evaluator, FootprintQuery};
 use crate::microfacet::brdf::filtered_specular;
@@ -21,6 +22,13 @@ impl Evaluator {
         self.filtered_lit(cfg, 1.0, &DMat3::IDENTITY)
     }
 
+    /// [`Evaluator::filtered`] with the slopes as the binned mixture over the driver's value
+    /// whatever the material says ([`crate::eval::mixture_bins`]; under the identity transfer it
+    /// is one Gaussian with D_h integrated exactly): for tests and `lodestone diagnose`.
+    pub fn filtered_as_mixture(&self, cfg: &FootprintQuery) -> [f64; 3] {
+        self.filtered_with(cfg, 1.0, &DMat3::IDENTITY, true)
+    }
+
     /// [`Evaluator::filtered`] with the sun's visibility and the tangent frame, as
     /// [`Evaluator::naive`]'s.
     pub(super) fn filtered_lit(
@@ -28,6 +36,18 @@ impl Evaluator {
         cfg: &FootprintQuery,
         sun_visible: f64,
         frame: &DMat3,
+    ) -> [f64; 3] {
+        let mixture = self.material.transfer_mixture();
+        self.filtered_with(cfg, sun_visible, frame, mixture)
+    }
+
+    /// [`Evaluator::filtered_lit`], the slopes one Gaussian or (`mixture`) the binned mixture.
+    fn filtered_with(
+        &self,
+        cfg: &FootprintQuery,
+        sun_visible: f64,
+        frame: &DMat3,
+        mixture: bool,
     ) -> [f64; 3] {
         let loc = self.footprint_stats(cfg);
         let nbar = normal_of(loc.stats.slope_mean);
@@ -41,6 +61,9 @@ impl Evaluator {
         // kept just above its horizon so that the result is continuous across the tilt instead
         // of black ([`above_horizon`]).
         let (wo, wi) = (above_horizon(to_local(cfg.wo)), to_local(cfg.wi));
+        if mixture {
+            return self.filtered_bins(&loc, cfg, (wo, wi), sun_visible, frame);
+        }
         let sigma = loc.stats.slope_cov;
         let f = &self.material.filtering;
         let ms = G2::from_directions(wo, wi, &sigma, f.correlation);

@@ -140,31 +140,40 @@ fn views_past_60_degrees_filter_to_ground_truth() {
 }
 
 /// Transfer curves (moss) with the colour indexed by the driver and by the transformed height.
-/// The model is known to be off here (#17: the colour of g(f) is averaged as if g(f) were
-/// Gaussian, and colour and slope correlate through g′(f)): measured (20k rays) up to 23% with
-/// the driver's colour and 34% with the height's, worst under the opposite light at 60°. These
-/// bounds only guard against regressions; #17 is to bring them under the 60° bounds above.
+/// One Gaussian (`transfer_slopes: Gaussian`, the papers' model) was off by up to 23% with the
+/// driver's colour and 34% with the height's (#17: the colour of g(f) averaged as if g(f) were
+/// Gaussian, colour and slope correlated through g′(f)). The binned mixture the model now uses
+/// (`crate::eval::mixture_bins`): ≤ 2.8% up to 30° (blue, whose map values are smallest),
+/// ≤ 7.1% at 60° (red under the opposite light: the 241-node mixture is 8.8% there, so the
+/// residual is not the binning). Bounds: 4% up to 30°, 9% at 60°, plus 3 s.e. (10k rays).
 #[test]
 fn transfer_curves_against_ground_truth() {
     let mut m = gaussian_material();
     m.heights.transfer = TransferFunction::Curve(Curve::moss());
-    check(
+    let a = check(
         "moss curve, driver colour",
         &m,
         &[0.0, 30.0, 60.0],
-        |_| 0.25,
+        moss_bound,
         10_000,
     );
+    assert!(a > 1e-3, "suspiciously exact: {a}");
     if let ColorModel::Gradient { source, .. } = &mut m.color {
         *source = ColorSource::Height;
     }
-    check(
+    let b = check(
         "moss curve, height colour",
         &m,
         &[0.0, 30.0, 60.0],
-        |_| 0.36,
+        moss_bound,
         10_000,
     );
+    assert!(b > 1e-3, "suspiciously exact: {b}");
+}
+
+/// The moss bounds: 4% up to 30°, 9% at 60°.
+fn moss_bound(deg: f64) -> f64 {
+    if deg > 45.0 { 0.09 } else { 0.04 }
 }
 
 /// The cylinder (radius 60, seen from 1500 units: each pixel spans ~10 features): the analytic

@@ -17,7 +17,9 @@
 //!   D_s ∝ p(s)·(ωo_z − s·ωo_xy)⁺ [HNPN14 Sec. 5.2] on n² polar nodes ([`crate::microfacet::visible_slopes::slope_rule`], n = 8 by
 //!   default) jointly with the slope colour and environment irradiance, and ρ̄_s the Beckmann lobe
 //!   widened by the unresolved slopes (σ_n² + σ_n0² [HN12 Sec. 5.5]). Transfer functions enter
-//!   through their moment tables [HNPN14 Eqs. 21–26].
+//!   through their moment tables [HNPN14 Eqs. 21–26]; under a transfer curve the slopes are a
+//!   mixture of Gaussians over bins of the driver's value with height-dependent masking
+//!   ([`mixture_bins`]; the 241-node form it is checked against: [`mixture`]).
 //! * **Ground truth**: eye rays through points drawn from `w_P`, marched onto the explicit surface
 //!   ([`crate::scene::surface::Surface::march`]), shaded with the base BRDF at the true micro-normal, with a real shadow ray.
 //!   No Smith, no Λ. Reported with its standard error.
@@ -34,6 +36,7 @@ pub mod filtered;
 pub mod ground_truth;
 pub mod lod_surface;
 pub mod mixture;
+pub mod mixture_bins;
 pub mod naive;
 pub mod pixel;
 pub mod query;

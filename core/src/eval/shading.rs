@@ -23,6 +23,19 @@ pub struct SlopeShading {
     pub cs_env: [f64; 3],
 }
 
+impl SlopeShading {
+    /// Every input times `k`.
+    #[must_use]
+    pub fn scaled(self, k: f64) -> Self {
+        Self {
+            cos: self.cos * k,
+            cs_cos: self.cs_cos.map(|v| v * k),
+            env: self.env.map(|v| v * k),
+            cs_env: self.cs_env.map(|v| v * k),
+        }
+    }
+}
+
 impl Evaluator {
     /// `C_s(n)` of the slope term (0 without one).
     pub(super) fn slope_color_at(&self, n: DVec3) -> [f64; 3] {
@@ -63,8 +76,27 @@ impl Evaluator {
         wi: DVec3,
         frame: &DMat3,
     ) -> SlopeShading {
-        let mut acc = SlopeShading::default();
         let points = self.material.filtering.slope_points as usize;
+        let (acc, den) = self.visible_shading_sums(mean, sigma, wo, wi, frame, points);
+        if den > 0.0 {
+            acc.scaled(1.0 / den)
+        } else {
+            SlopeShading::default()
+        }
+    }
+
+    /// The sums [`Evaluator::visible_shading`] divides: each input weighted by the node's
+    /// visible projected area, and the sum of those weights, on the rule of order `points`.
+    pub(super) fn visible_shading_sums(
+        &self,
+        mean: DVec2,
+        sigma: &SlopeCov,
+        wo: DVec3,
+        wi: DVec3,
+        frame: &DMat3,
+        points: usize,
+    ) -> (SlopeShading, f64) {
+        let mut acc = SlopeShading::default();
         let den = visible_slope_nodes(mean, sigma, wo, points, |n, w| {
             let p = self.point_shading(n, wi, frame);
             acc.cos += w * p.cos;
@@ -74,18 +106,7 @@ impl Evaluator {
                 acc.cs_env[c] += w * p.cs_env[c];
             }
         });
-        if den > 0.0 {
-            let inv = 1.0 / den;
-            acc.cos *= inv;
-            for c in 0..3 {
-                acc.cs_cos[c] *= inv;
-                acc.env[c] *= inv;
-                acc.cs_env[c] *= inv;
-            }
-            acc
-        } else {
-            SlopeShading::default()
-        }
+        (acc, den)
     }
 
     /// Radiance from the combined colour `A + K ⊙ C_s` (`sun_color` under the directional light,

@@ -35,6 +35,10 @@ pub enum Feature {
     AttributeColor,
     /// A height transfer curve g (its moment polynomial and table) [HNPN14 Sec. 7].
     TransferCurve,
+    /// Slopes under a transfer curve as a mixture over the driver's value: bins of the
+    /// footprint's quantiles with their own Gaussian slopes and height-dependent masking
+    /// ([`crate::microfacet::height_mixture`]; needs relief and a curve).
+    TransferMixture,
     /// Relief: σ_h > 0, so heights, slopes, the ray march, masking, the visible-height table D_h
     /// [HNPN14 Eqs. 14–17] and the visible-slope quadrature are needed.
     Relief,
@@ -55,13 +59,14 @@ pub enum Feature {
 
 impl Feature {
     /// Every feature, in a fixed order.
-    pub const ALL: [Feature; 12] = [
+    pub const ALL: [Feature; 13] = [
         Feature::NoiseDriver,
         Feature::ImageDriver,
         Feature::DriverColor,
         Feature::HeightColor,
         Feature::AttributeColor,
         Feature::TransferCurve,
+        Feature::TransferMixture,
         Feature::Relief,
         Feature::Shadows,
         Feature::Specular,
@@ -79,6 +84,7 @@ impl Feature {
             Feature::HeightColor => "height_color",
             Feature::AttributeColor => "attribute_color",
             Feature::TransferCurve => "transfer_curve",
+            Feature::TransferMixture => "transfer_mixture",
             Feature::Relief => "relief",
             Feature::Shadows => "shadows",
             Feature::Specular => "specular",
@@ -139,11 +145,16 @@ impl FeatureSet {
     }
 
     /// The set with the implications between features applied: shadows need relief (a flat
-    /// plane casts none; the shadow march needs the level-of-detail surface).
+    /// plane casts none; the shadow march needs the level-of-detail surface); the transfer
+    /// mixture needs relief and a transfer curve.
     #[must_use]
     pub fn normalized(self) -> FeatureSet {
         let relief = self.contains(Feature::Relief);
+        let mixture = relief
+            && self.contains(Feature::TransferCurve)
+            && self.contains(Feature::TransferMixture);
         self.with(Feature::Shadows, relief && self.contains(Feature::Shadows))
+            .with(Feature::TransferMixture, mixture)
     }
 
     /// The features of the material alone (no scene): see [`FeatureSet::derive`].
@@ -186,6 +197,7 @@ impl FeatureSet {
                 Feature::TransferCurve,
                 matches!(m.heights.transfer, TransferFunction::Curve(_)),
             )
+            .with(Feature::TransferMixture, m.transfer_mixture())
             .with(Feature::Relief, relief)
             .with(Feature::Specular, m.brdf.specular > 0.0)
             .with(Feature::SlopeColor, m.terms.slope.is_some())
@@ -243,6 +255,15 @@ impl FeatureSet {
                         }
                     }
                     Feature::TransferCurve => "the height transfer function is the identity",
+                    Feature::TransferMixture => {
+                        if !matches!(m.heights.transfer, TransferFunction::Curve(_)) {
+                            "the identity transfer keeps the slopes one Gaussian"
+                        } else if m.heights.sigma_h <= 0.0 {
+                            "sigma_h is 0: no slopes to mix"
+                        } else {
+                            "filtering.transfer_slopes is Gaussian (the papers' model)"
+                        }
+                    }
                     Feature::Relief => "sigma_h is 0: the surface is flat",
                     Feature::Shadows => {
                         if m.heights.sigma_h > 0.0 {

@@ -31,6 +31,7 @@ use crate::material::transfer::TransferFunction;
 use crate::material::validation::{Problem, Problems};
 use crate::microfacet::brdf::BaseBrdf;
 use crate::microfacet::effective_height::HeightFilter;
+use crate::microfacet::height_mixture::TransferSlopes;
 use crate::microfacet::masking_shadowing::Correlation;
 use crate::microfacet::slopes::SlopeCov;
 use serde::{Deserialize, Serialize};
@@ -128,6 +129,8 @@ pub struct Filtering {
     /// the visible slope distribution D_s
     /// (the GPU evaluates n² points per pixel).
     pub slope_points: u32,
+    /// Slopes under a transfer curve: a mixture over the driver's value (default) or one Gaussian.
+    pub transfer_slopes: TransferSlopes,
 }
 
 impl Default for Filtering {
@@ -137,6 +140,7 @@ impl Default for Filtering {
             height_filter: HeightFilter::default(),
             table: TableSpec::default(),
             slope_points: Self::DEFAULT_SLOPE_POINTS,
+            transfer_slopes: TransferSlopes::default(),
         }
     }
 }
@@ -239,6 +243,15 @@ impl Default for Material {
 }
 
 impl Material {
+    /// Whether the filtered view models the slopes as a mixture over the driver's value
+    /// ([`crate::microfacet::height_mixture`]): a transfer curve on relief, with
+    /// [`TransferSlopes::Mixture`] (under the identity the mixture is one Gaussian).
+    pub fn transfer_mixture(&self) -> bool {
+        self.heights.sigma_h > 0.0
+            && matches!(self.heights.transfer, TransferFunction::Curve(_))
+            && self.filtering.transfer_slopes == TransferSlopes::Mixture
+    }
+
     /// Parse RON, then validate. Errors carry line and column where the parser has them.
     pub fn from_ron(text: &str) -> Result<Self, MaterialError> {
         let options = ron::Options::default();

@@ -10,12 +10,14 @@
 //! | G2, L = Λo ⊕ Λi, V̄ | [`masking_shadowing`] | [HNPN14 Eqs. 11–12] |
 //! | D_h, its moments and fits | [`effective_height`] | [HNPN14 Eqs. 14–17] |
 //! | D_s, the slope rule that runs | [`visible_slopes`] | [HNPN14 Sec. 5.2] |
+//! | slopes under a transfer curve: bins, masking | [`height_mixture`] | #17, Smith 1967 |
 //! | base BRDF, filtered specular | [`brdf`] | [HN12 Sec. 5.5] |
 //! | a(h) = ā + a_s·s(h) | [`attribute`] | [HN12 Eq. 17] |
 
 pub mod attribute;
 pub mod brdf;
 pub mod effective_height;
+pub mod height_mixture;
 pub mod masking_shadowing;
 pub mod slopes;
 pub mod smith;

@@ -1,0 +1,132 @@
+//! The filtered model under a transfer curve: the footprint's slopes as a mixture of Gaussians
+//! over bins of the driver's value, each with its colour, its visible-slope shading and
+//! height-dependent masking ([`crate::microfacet::height_mixture`]).
+//!
+//! Per bin b (quantiles [lo, hi] of the footprint's driver N(f̄, σ_f²), [`mixture_edges`]): the
+//! mean ḡ′_b and root mean square of g′ and the mean colour C_b of the points in it (on
+//! [`BIN_SAMPLES`] midpoints in u, [`Evaluator::bin_moments`]); its slopes
+//! `N(σ_h ḡ′_b·∇f̄, σ_h² E_b[g′²]·Σ_∇f)`, their Λ(ωo), Λ(ωi) and joint exponent L_b ([`G2`]); the
+//! visible-slope sums on n² nodes ([`bin_slope_points`]). With `W1_b` the bin's weight times its
+//! mean visibility along ωo and `W2_b` the same for the joint masking–shadowing ([`bin_masking`],
+//! chained from the top bin down), and `So_b` the bin's visible projected area,
+//!
+//! `I = Σ_b [W2_b·E_sun·(ρ/π·(A_b⊙S_b + K_b⊙S^C_b) + So_b·ρ_s,b) + W1_b·ρ/π·(A_b⊙S^env_b +
+//! K_b⊙S^Cenv_b)] / Σ_b W1_b·So_b`
+//!
+//! (`A_b + K_b ⊙ C_s` the colour terms of C_b, S the visible-slope sums of [`SlopeShading`],
+//! ρ_s,b the bin's widened specular lobe per unit visible area, [`filtered_specular`]). With the
+//! identity transfer every bin has the same slopes and this is the filtered model with D_h
+//! integrated exactly (tested). Against the 241-node mixture ([`Evaluator::filtered_mixture`]) on
+//! the moss, sponge and terraces presets: within 0.1%, 0.8% and 5.1% (terraces at 75°; a riser
+//! whose g′ runs from 0 to its peak inside one bin is still one Gaussian).
+
+use crate::eval::query::FootprintStats;
+use crate::eval::shading::SlopeShading;
+use crate::eval::{Evaluator, FootprintQuery};
+use crate::material::transfer::TransferFunction;
+use crate::math::special::norm_quantile;
+use crate::microfacet::brdf::filtered_specular;
+use crate::microfacet::height_mixture::{
+    BIN_SAMPLES, bin_exponent, bin_slope_points, bin_masking, mixture_edges,
+};
+use crate::microfacet::masking_shadowing::G2;
+use glam::{DMat3, DVec3};
+use std::f64::consts::FRAC_1_PI;
+
+/// What a bin of the driver's value contributes: its mean g′, the root mean square of g′ and the
+/// mean point colour.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BinMoments {
+    /// Mean of g′ over the bin.
+    pub mean_deriv: f64,
+    /// √E[g′²] over the bin.
+    pub rms_deriv: f64,
+    /// Mean colour of its points ([`Evaluator::color_at`]).
+    pub color: [f64; 3],
+}
+
+impl Evaluator {
+    /// [`BinMoments`] of the quantiles [lo, hi] of N(mean, std²), on [`BIN_SAMPLES`] midpoints in u.
+    pub fn bin_moments(&self, mean: f64, std: f64, lo: f64, hi: f64) -> BinMoments {
+        let g = &self.material.heights.transfer;
+        let (mut d1, mut d2, mut color) = (0.0, 0.0, [0.0; 3]);
+        let k = 1.0 / BIN_SAMPLES as f64;
+        for q in 0..BIN_SAMPLES {
+            let u = lo + (hi - lo) * (q as f64 + 0.5) * k;
+            let f = mean + std * norm_quantile(u);
+            let gd = g.derivative(f);
+            d1 += gd * k;
+            d2 += gd * gd * k;
+            let c = self.color_at(f);
+            for ch in 0..3 {
+                color[ch] += c[ch] * k;
+            }
+        }
+        BinMoments {
+            mean_deriv: d1,
+            rms_deriv: d2.max(0.0).sqrt(),
+            color,
+        }
+    }
+
+    /// The filtered model with the footprint's slopes as the binned mixture (module docs), `wo`
+    /// and `wi` in the frame of the footprint's mean normal (for Λ), `cfg`'s in the macro frame
+    /// (for the slope averages, which live in world slope space), `sun_visible` the shadow ray's
+    /// verdict and `frame` the tangent frame, as [`Evaluator::filtered`] takes them.
+    pub(super) fn filtered_bins(
+        &self,
+        loc: &FootprintStats,
+        cfg: &FootprintQuery,
+        (wo, wi): (DVec3, DVec3),
+        sun_visible: f64,
+        frame: &DMat3,
+    ) -> [f64; 3] {
+        let m = &self.material;
+        let d = loc.driver;
+        let knots: Vec<f64> = match &m.heights.transfer {
+            TransferFunction::Curve(c) => c.points.iter().map(|p| p[0]).collect(),
+            TransferFunction::Identity => Vec::new(),
+        };
+        let edges = mixture_edges(&knots, d.mean, d.std);
+        let sigma_h = self.surface.sigma_h;
+        let sun_lit = wi.z > 0.0 && cfg.wi.z > 0.0;
+        let b = &m.brdf;
+        let kd = b.albedo * FRAC_1_PI;
+        let sun = m.lighting.sun * sun_visible;
+        let points = bin_slope_points(m.filtering.slope_points, m.terms.slope.is_some());
+        let (mut above_o, mut above) = (0.0, 0.0);
+        let (mut num, mut den) = ([0.0f64; 3], 0.0f64);
+        for e in edges.windows(2).rev() {
+            let (lo, hi) = (e[0], e[1]);
+            if !(hi > lo) {
+                continue;
+            }
+            let bin = self.bin_moments(d.mean, d.std, lo, hi);
+            let mean = d.mean_gradient * (sigma_h * bin.mean_deriv);
+            let cov = d.gradient_cov.scaled(sigma_h * bin.rms_deriv);
+            let ms = G2::from_directions(wo, wi, &cov, m.filtering.correlation);
+            let w1 = bin_masking(lo, hi, ms.lambda_o, above_o);
+            let w2 = bin_masking(lo, hi, ms.total, above);
+            above_o += bin_exponent(lo, hi, ms.lambda_o);
+            above += bin_exponent(lo, hi, ms.total);
+            let (s, s_o): (SlopeShading, f64) =
+                self.visible_shading_sums(mean, &cov, cfg.wo, cfg.wi, frame, points);
+            den += w1 * s_o;
+            let (v, spec) = if sun_lit {
+                let lobe = filtered_specular(b.specular, b.roughness, mean, &cov, cfg.wo, cfg.wi);
+                (w2 * sun, lobe * s_o)
+            } else {
+                (0.0, 0.0)
+            };
+            let c = m.terms.affine(bin.color);
+            for ch in 0..3 {
+                num[ch] += v * (kd * (c.a[ch] * s.cos + c.k[ch] * s.cs_cos[ch]) + spec)
+                    + w1 * kd * (c.a[ch] * s.env[ch] + c.k[ch] * s.cs_env[ch]);
+            }
+        }
+        if !(den > 0.0) {
+            return [0.0; 3];
+        }
+        num.map(|v| v / den)
+    }
+}
