@@ -241,10 +241,10 @@ gpu_struct! {
         /// Monotonicity of the transfer function: 1 never decreasing (the identity too), 2 never
         /// increasing, 0 neither (core's `OctaveSurface::monotone`).
         transfer_monotone: u32 => "u32",
-        /// Padding to WGSL's 16-byte struct size.
-        pad1: u32 => "u32",
-        /// Padding.
-        pad2: u32 => "u32",
+        /// Offset of the slope rule each bin of the transfer mixture uses.
+        mix_rule_offset: u32 => "u32",
+        /// n of that n × n rule; 0 when the filtered view keeps one Gaussian (no mixture).
+        mix_points: u32 => "u32",
     }
 }
 

@@ -20,6 +20,7 @@ use lodestone_core::material::{ColorModel, ColorSource};
 use lodestone_core::math::piecewise::PiecewisePoly;
 use lodestone_core::microfacet::effective_height::{EffectiveHeightTable, HeightFilter};
 use lodestone_core::microfacet::masking_shadowing::Correlation;
+use lodestone_core::microfacet::height_mixture::bin_slope_points;
 use lodestone_core::microfacet::visible_slopes::slope_rule;
 use lodestone_core::scene::bound_grid::BoundGrid;
 use lodestone_core::scene::camera::{Camera, PIXEL_SIGMA};
@@ -522,6 +523,19 @@ pub fn material_data_for(
             data.extend([z.x as f32, z.y as f32, *w as f32]);
         }
         mark(&data, start, "slope quadrature rule");
+        if m.transfer_mixture() {
+            let n = bin_slope_points(m.filtering.slope_points, m.terms.slope.is_some());
+            base.mix_points = n as u32;
+            base.mix_rule_offset = lay.slope_rule;
+            if n != points {
+                let start = data.len();
+                base.mix_rule_offset = data.len() as u32;
+                for (z, w) in slope_rule(n) {
+                    data.extend([z.x as f32, z.y as f32, *w as f32]);
+                }
+                mark(&data, start, "slope rule of the transfer mixture's bins");
+            }
+        }
     }
     match &m.color {
         ColorModel::Gradient { map, source } => {

@@ -49,6 +49,9 @@ fn every_wgsl_file_validates() {
 const MIRRORS: &[(&str, &str, &str, &str)] = &[
     ("math/special.wgsl", "erfc_upper", "math/special_f32.rs", "erfc_upper"),
     ("math/special.wgsl", "erf_small", "math/special_f32.rs", "erf_small"),
+    ("math/special.wgsl", "norm_quantile", "math/special_f32.rs", "norm_quantile"),
+    ("math/special.wgsl", "acklam", "math/special_f32.rs", "acklam"),
+    ("math/special.wgsl", "lower_quantile", "math/special_f32.rs", "lower_quantile"),
     ("math/piecewise.wgsl", "poly_eval", "math/piecewise.rs", "eval"),
     ("math/piecewise.wgsl", "poly_max_abs_on", "math/piecewise.rs", "max_abs_on"),
     ("microfacet/smith.wgsl", "projected_std", "microfacet/slopes.rs", "projected_std"),
@@ -327,4 +330,39 @@ fn wgsl_special_functions_match_core_on_the_adapter() {
         total += xs.len();
     }
     assert!(total >= 10_000);
+}
+
+/// norm_quantile (the mixture's bin samples): the WGSL Acklam approximation against core's f64
+/// quantile (with Newton steps) over p in [1e-7, 1 − 1e-7], relative to (1 + κ) like the rest;
+/// and finite at 0, 1 and beyond.
+#[test]
+fn wgsl_norm_quantile_matches_core_on_the_adapter() {
+    let Some(ctx) = lodestone_tests::gpu("the GPU mirror test") else {
+        return;
+    };
+    let mut xs: Vec<f32> = (0..4000).map(|i| (i as f32 + 0.5) / 4000.0).collect();
+    xs.extend((1..=7).flat_map(|e| {
+        let t = 10f32.powi(-e);
+        [t, 1.0 - t, 3.0 * t]
+    }));
+    xs.extend([0.5, 0.0, 1.0, -1.0, 2.0]);
+    let gpu = eval_unary(&ctx, shaders::SPECIAL, "norm_quantile", &xs);
+    let mut worst = 0.0f64;
+    for (x, g) in xs.iter().zip(&gpu) {
+        assert!(g.is_finite() && g.abs() < 11.5, "norm_quantile({x}): GPU gave {g}");
+        if !(*x >= 1e-7 && *x <= 1.0 - 1e-7) {
+            continue;
+        }
+        let want = special::norm_quantile(f64::from(*x));
+        let cpu32 = f64::from(special_f32::norm_quantile(*x));
+        let kappa = condition(special::norm_quantile, f64::from(*x));
+        let err = (f64::from(*g) - want).abs();
+        let rel = if want == 0.0 { err } else { err / want.abs() };
+        assert!(
+            rel <= REL_TOL * (1.0 + kappa) || err < 1e-6,
+            "norm_quantile({x}): GPU {g:e}, core {want:e} (core f32 {cpu32:e}), relative {rel:.2e}, κ {kappa:.2e}"
+        );
+        worst = worst.max(rel / (1.0 + kappa));
+    }
+    eprintln!("norm_quantile: {} inputs, worst relative error / (1 + κ) {worst:.2e}", xs.len());
 }

@@ -78,8 +78,28 @@ fn has_environment() -> bool {
 // Evaluator::visible_shading: point_shading averaged on the nodes of D_s (visible_slope_nodes),
 // world slope space, slopes N(mean, cov).
 fn visible_shading(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> SlopeShading {
+    let sums = visible_shading_sums(mean, cov, wo, wi, params.slope_rule_offset, params.slope_points);
+    var acc = sums.s;
+    if (sums.den > 0.0) {
+        let inv = 1.0 / sums.den;
+        acc.cos = acc.cos * inv;
+        acc.cs_cos = acc.cs_cos * inv;
+        acc.env = acc.env * inv;
+        acc.cs_env = acc.cs_env * inv;
+    }
+    return acc;
+}
+
+// The sums visible_shading divides, and the sum of the weights.
+struct ShadingSums {
+    s: SlopeShading,
+    den: f32,
+}
+
+// Evaluator::visible_shading_sums, on the n × n rule stored at `rule_off`.
+fn visible_shading_sums(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, rule_off: u32, points: u32) -> ShadingSums {
     let l = cholesky(cov);
-    let nodes = params.slope_points * params.slope_points;
+    let nodes = points * points;
     var acc: SlopeShading;
     acc.cos = 0.0;
     acc.cs_cos = vec3<f32>(0.0);
@@ -87,7 +107,8 @@ fn visible_shading(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>
     acc.cs_env = vec3<f32>(0.0);
     var den = 0.0;
     for (var i = 0u; i < nodes; i = i + 1u) {
-        let z = slope_node(i);
+        let b = rule_off + 3u * i;
+        let z = vec3<f32>(data[b], data[b + 1u], data[b + 2u]);
         let s = mean + vec2<f32>(l.x * z.x, l.y * z.x + l.z * z.y);
         let u = max(wo.z - s.x * wo.x - s.y * wo.y, 0.0);
         let wt = z.z * u;
@@ -100,13 +121,6 @@ fn visible_shading(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>
             den = den + wt;
         }
     }
-    if (den > 0.0) {
-        let inv = 1.0 / den;
-        acc.cos = acc.cos * inv;
-        acc.cs_cos = acc.cs_cos * inv;
-        acc.env = acc.env * inv;
-        acc.cs_env = acc.cs_env * inv;
-    }
-    return acc;
+    return ShadingSums(acc, den);
 }
 //#endif

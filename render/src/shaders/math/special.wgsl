@@ -87,6 +87,43 @@ fn norm_cdf(z: f32) -> f32 {
     return 0.5 * erfc(-z * FRAC_1_SQRT_2);
 }
 
+// special_f32::norm_quantile: Acklam's approximation, p clamped to [1e-30, 1 − 2⁻²⁴].
+fn norm_quantile(p_in: f32) -> f32 {
+    var p = 1e-30;
+    if (p_in > 1e-30) {
+        p = min(p_in, 1.0 - 5.9604645e-8);
+    }
+    if (p > 0.5) {
+        return -lower_quantile(1.0 - p);
+    }
+    return lower_quantile(p);
+}
+
+// special_f32::lower_quantile: Acklam, then one Newton step below p = 0.2.
+fn lower_quantile(p: f32) -> f32 {
+    let x = acklam(p);
+    if (p < 0.2) {
+        let d = norm_pdf(x);
+        if (d > 0.0) {
+            return x - (norm_cdf(x) - p) / d;
+        }
+    }
+    return x;
+}
+
+// special_f32::acklam, 0 < p ≤ 0.5.
+fn acklam(p: f32) -> f32 {
+    if (p < 0.02425) {
+        let q = sqrt(-2.0 * log(p));
+        return (((((-7.784894e-3 * q - 3.2239646e-1) * q - 2.4007583) * q - 2.5497325) * q + 4.374664) * q + 2.938164)
+            / ((((7.7846957e-3 * q + 3.2246713e-1) * q + 2.4451341) * q + 3.7544086) * q + 1.0);
+    }
+    let q = p - 0.5;
+    let r = q * q;
+    return (((((-3.969683e1 * r + 2.209461e2) * r - 2.759285e2) * r + 1.3835775e2) * r - 3.0664798e1) * r + 2.5066283) * q
+        / (((((-5.44761e1 * r + 1.6158584e2) * r - 1.5569898e2) * r + 6.680131e1) * r - 1.3280681e1) * r + 1.0);
+}
+
 fn log_norm_cdf(z: f32) -> f32 {
     if (z < -3.0) {
         // x² overflows f32 beyond x ≈ 1.8e19: saturate at core's f32::MIN (WGSL cannot test for
