@@ -349,7 +349,10 @@ fn wgsl_norm_quantile_matches_core_on_the_adapter() {
     let gpu = eval_unary(&ctx, shaders::SPECIAL, "norm_quantile", &xs);
     let mut worst = 0.0f64;
     for (x, g) in xs.iter().zip(&gpu) {
-        assert!(g.is_finite() && g.abs() < 11.5, "norm_quantile({x}): GPU gave {g}");
+        assert!(
+            g.is_finite() && g.abs() < 11.5,
+            "norm_quantile({x}): GPU gave {g}"
+        );
         if !(*x >= 1e-7 && *x <= 1.0 - 1e-7) {
             continue;
         }
@@ -364,5 +367,8 @@ fn wgsl_norm_quantile_matches_core_on_the_adapter() {
         );
         worst = worst.max(rel / (1.0 + kappa));
     }
-    eprintln!("norm_quantile: {} inputs, worst relative error / (1 + κ) {worst:.2e}", xs.len());
+    eprintln!(
+        "norm_quantile: {} inputs, worst relative error / (1 + κ) {worst:.2e}",
+        xs.len()
+    );
 }

@@ -14,6 +14,7 @@ use lodestone_core::material::slope_color::SlopeColor;
 use lodestone_core::material::transfer::{SurfaceShape, TransferFunction};
 use lodestone_core::material::{ColorModel, ColorSource, Driver, Filtering, Material};
 use lodestone_core::microfacet::effective_height::HeightFilter;
+use lodestone_core::microfacet::height_mixture::TransferSlopes;
 use lodestone_core::microfacet::masking_shadowing::Correlation;
 use std::sync::Arc;
 
@@ -225,7 +226,10 @@ impl Inspector {
             });
         egui::CollapsingHeader::new("Filtering")
             .default_open(false)
-            .show(ui, |ui| changed |= filtering(ui, &mut m.filtering));
+            .show(ui, |ui| {
+                changed |= filtering(ui, &mut m.filtering);
+                transfer_model_note(ui, m);
+            });
         changed
     }
 
@@ -642,6 +646,23 @@ fn lighting(ui: &mut Ui, l: &mut Lighting) -> bool {
     changed
 }
 
+/// Which slope model the filtered view runs for this material, and why (the reason `lodestone
+/// inspect` gives).
+fn transfer_model_note(ui: &mut Ui, m: &Material) {
+    let features = FeatureSet::of_material(m);
+    let text = if features.contains(Feature::TransferMixture) {
+        "Slopes: mixture over the driver's value (a transfer curve on relief)".to_owned()
+    } else {
+        let why = features
+            .absent(m)
+            .into_iter()
+            .find(|(f, _)| *f == Feature::TransferMixture)
+            .map_or("", |(_, why)| why);
+        format!("Slopes: one Gaussian ({why})")
+    };
+    ui.weak(text);
+}
+
 fn filtering(ui: &mut Ui, f: &mut Filtering) -> bool {
     let mut changed = false;
     let mut c = f.correlation;
@@ -668,6 +689,19 @@ fn filtering(ui: &mut Ui, f: &mut Filtering) -> bool {
         .on_hover_text("Moments of the visible height distribution D_h: exact table or the paper's fits [HNPN14 Sec. 5.1]");
     if h != f.height_filter {
         f.height_filter = h;
+        changed = true;
+    }
+    let mut t = f.transfer_slopes;
+    egui::ComboBox::from_label("Transfer slopes")
+        .selected_text(format!("{t:?}"))
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut t, TransferSlopes::Mixture, "Mixture");
+            ui.selectable_value(&mut t, TransferSlopes::Gaussian, "Gaussian");
+        })
+        .response
+        .on_hover_text("Slopes under a transfer curve g: a mixture of Gaussians over bins of the driver's value, N(σ_h g′(f)∇f̄, σ_h² g′(f)² Σ_∇f), with height-dependent masking (default), or one Gaussian of the same second moment [HNPN14 Eqs. 19–26]");
+    if t != f.transfer_slopes {
+        f.transfer_slopes = t;
         changed = true;
     }
     changed |= ui

@@ -331,3 +331,85 @@ fn slope_density_of_the_noise_in_its_tails() {
         );
     }
 }
+
+/// The sponge and terraces presets (steep pits, treads and risers) against the ray-traced truth:
+/// one Gaussian is 34–47% off at these configurations, the binned mixture within 2% (measured
+/// with 200k rays: sponge −0.32% at 0°, +1.02% at 75°; terraces −2.00% at 30°, +0.85% at 60°).
+/// Bounds 3% plus 3 s.e. of 20k rays.
+#[test]
+fn transfer_presets_filter_to_ground_truth() {
+    for (name, view, light, az) in [
+        ("sponge", 0.0, 0.0, 0.0),
+        ("sponge", 75.0, 30.0, 180.0),
+        ("terraces", 30.0, 30.0, 180.0),
+        ("terraces", 60.0, 30.0, 0.0),
+    ] {
+        let text = std::fs::read_to_string(format!(
+            "{}/../presets/{name}.ron",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .expect("preset");
+        let p = Evaluator::new(&Material::from_ron(&text).expect("valid")).expect("prepared");
+        let wi = direction(f64::to_radians(light), f64::to_radians(az));
+        let cfg = FootprintQuery::far(&p, direction(f64::to_radians(view), 0.0), wi);
+        let gt = p.ground_truth(&cfg, 20_000, 43);
+        let (over, rel) = excess(p.filtered(&cfg), &gt);
+        assert!(
+            over < 0.03,
+            "{name} {view}°/{light}°/{az}°: {:+.2?}% (± {:.2?})",
+            rel.map(|r| 100.0 * r),
+            gt.std_error
+        );
+    }
+}
+
+/// The library's transfer-curve presets against the ray-traced truth: the binned mixture the
+/// views run, one Gaussian and the 241-node mixture (measurement for #17's closing note, far
+/// patch, 200k rays; `cargo test --release -- --ignored --nocapture transfer_presets`).
+#[test]
+#[ignore = "a measurement, prints a table"]
+fn transfer_presets_against_ground_truth() {
+    use crate::microfacet::height_mixture::TransferSlopes;
+    for name in ["moss", "sponge", "terraces"] {
+        let text = std::fs::read_to_string(format!(
+            "{}/../presets/{name}.ron",
+            env!("CARGO_MANIFEST_DIR")
+        ))
+        .expect("preset");
+        let m = Material::from_ron(&text).expect("valid");
+        let p = Evaluator::new(&m).expect("prepared");
+        let mut g = m.clone();
+        g.filtering.transfer_slopes = TransferSlopes::Gaussian;
+        let pg = Evaluator::new(&g).expect("prepared");
+        for (view, light, az) in [
+            (0.0, 0.0, 0.0),
+            (30.0, 30.0, 180.0),
+            (45.0, 60.0, 0.0),
+            (60.0, 30.0, 0.0),
+            (75.0, 30.0, 180.0),
+            (85.0, 0.0, 0.0),
+        ] {
+            let wi = if light == 0.0 {
+                DVec3::Z
+            } else {
+                direction(f64::to_radians(light), f64::to_radians(az))
+            };
+            let cfg = FootprintQuery::far(&p, direction(f64::to_radians(view), 0.0), wi);
+            let gt = p.ground_truth(&cfg, 200_000, 41);
+            let rel = |v: [f64; 3]| {
+                (0..3)
+                    .map(|k| 100.0 * (v[k] - gt.mean[k]) / gt.mean[k])
+                    .fold(0.0f64, |a, e| if e.abs() > a.abs() { e } else { a })
+            };
+            let se = (0..3)
+                .map(|k| 100.0 * gt.std_error[k] / gt.mean[k])
+                .fold(0.0f64, f64::max);
+            eprintln!(
+                "{name:9} view {view:2} light {light:2}/{az:3}: bins {:+6.2}%  gaussian {:+6.2}%  fine {:+6.2}%  (truth s.e. {se:.2}%)",
+                rel(p.filtered(&cfg)),
+                rel(pg.filtered(&cfg)),
+                rel(p.filtered_mixture(&cfg).expect("applies")),
+            );
+        }
+    }
+}

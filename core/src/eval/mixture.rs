@@ -213,7 +213,10 @@ mod tests {
                 // Φ(z)^L exactly: 0.25% apart at 75°.
                 for k in 0..3 {
                     assert!((a[k] - b[k]).abs() < 4e-3 * a[k], "{deg}°: {a:?} vs {b:?}");
-                    assert!((a[k] - bins[k]).abs() < 8e-3 * a[k], "{deg}°: {a:?} vs {bins:?}");
+                    assert!(
+                        (a[k] - bins[k]).abs() < 8e-3 * a[k],
+                        "{deg}°: {a:?} vs {bins:?}"
+                    );
                 }
             }
         }
@@ -246,7 +249,10 @@ mod tests {
             ] {
                 let cfg = far(deg, wi);
                 let gt = p.ground_truth(&cfg, 20_000, 29);
-                let (fi, mx) = (pg.filtered(&cfg), p.filtered_mixture(&cfg).expect("applies"));
+                let (fi, mx) = (
+                    pg.filtered(&cfg),
+                    p.filtered_mixture(&cfg).expect("applies"),
+                );
                 let bins = p.filtered(&cfg);
                 let rel = |v: [f64; 3], k: usize| (v[k] - gt.mean[k]).abs() / gt.mean[k];
                 let se = |k: usize| gt.std_error[k] / gt.mean[k];
@@ -323,7 +329,13 @@ mod binning {
                 );
                 let fine = p.filtered_mixture(&cfg).expect("applies");
                 let e = worst(p.filtered(&cfg), fine);
-                let bound = bounds[if deg < 30.0 { 0 } else if deg < 60.0 { 1 } else { 2 }];
+                let bound = bounds[if deg < 30.0 {
+                    0
+                } else if deg < 60.0 {
+                    1
+                } else {
+                    2
+                }];
                 assert!(e.abs() < bound, "{name} {deg}°: {e:+.2}% (bound {bound}%)");
             }
         }

@@ -27,7 +27,7 @@ use crate::material::transfer::TransferFunction;
 use crate::math::special::norm_quantile;
 use crate::microfacet::brdf::filtered_specular;
 use crate::microfacet::height_mixture::{
-    BIN_SAMPLES, bin_exponent, bin_slope_points, bin_masking, mixture_edges,
+    BIN_SAMPLES, bin_exponent, bin_masking, bin_slope_points, mixture_edges,
 };
 use crate::microfacet::masking_shadowing::G2;
 use glam::{DMat3, DVec3};

@@ -152,7 +152,11 @@ pub fn smith_lambda(nu: f32) -> f32 {
 /// `p > 0.5` is mirrored through `1 − p` (exact in f32 there); p is clamped to
 /// [1e-30, 1 − 2⁻²⁴] (NaN to the lower end): the result is always finite, within ±11.47.
 pub fn norm_quantile(p: f32) -> f32 {
-    let p = if p > 1e-30 { p.min(1.0 - 5.960_464_5e-8) } else { 1e-30 };
+    let p = if p > 1e-30 {
+        p.min(1.0 - 5.960_464_5e-8)
+    } else {
+        1e-30
+    };
     if p > 0.5 {
         return -lower_quantile(1.0 - p);
     }

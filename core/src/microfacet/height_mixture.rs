@@ -159,14 +159,20 @@ mod tests {
                 .sum();
             let b = bin_masking(lo, hi, l, above);
             // (The midpoint rule itself is 4e-5 off at Λ = 10⁴.)
-            assert!((b - quad).abs() <= 1e-9 + 1e-4 * quad, "Λ {l}: {b} vs {quad}");
+            assert!(
+                (b - quad).abs() <= 1e-9 + 1e-4 * quad,
+                "Λ {l}: {b} vs {quad}"
+            );
             let edges = mixture_edges(&[-0.5, 0.1, 0.7], 0.0, 1.0);
             let (mut acc, mut sum) = (0.0, 0.0);
             for w in edges.windows(2).rev() {
                 sum += bin_masking(w[0], w[1], l, acc);
                 acc += bin_exponent(w[0], w[1], l);
             }
-            assert!((sum - 1.0 / (l + 1.0)).abs() < 1e-12 * (1.0 + 1.0 / (l + 1.0)), "{sum}");
+            assert!(
+                (sum - 1.0 / (l + 1.0)).abs() < 1e-12 * (1.0 + 1.0 / (l + 1.0)),
+                "{sum}"
+            );
         }
         assert_eq!(bin_masking(0.3, 0.3, 2.0, 0.0), 0.0);
         assert_eq!(bin_exponent(0.3, 0.3, 2.0), 0.0);
