@@ -699,7 +699,7 @@ fn filtering(ui: &mut Ui, f: &mut Filtering) -> bool {
             ui.selectable_value(&mut t, TransferSlopes::Gaussian, "Gaussian");
         })
         .response
-        .on_hover_text("Slopes under a transfer curve g: a mixture of Gaussians over bins of the driver's value, N(σ_h g′(f)∇f̄, σ_h² g′(f)² Σ_∇f), with height-dependent masking (default), or one Gaussian of the same second moment [HNPN14 Eqs. 19–26]");
+        .on_hover_text("Slopes under a transfer curve g: a mixture of Gaussians over bins of the driver's value f (given f the slopes are Gaussian with std σ_h·g'(f) times the driver's gradient std), with height-dependent masking (default), or one Gaussian of the same second moment [HNPN14 Eqs. 19–26]");
     if t != f.transfer_slopes {
         f.transfer_slopes = t;
         changed = true;
