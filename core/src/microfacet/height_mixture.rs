@@ -154,7 +154,7 @@ mod tests {
             let quad: f64 = (0..n)
                 .map(|k| {
                     let u = lo + (hi - lo) * (k as f64 + 0.5) / n as f64;
-                    (-above as f64).exp() * (u / hi).powf(l) * (hi - lo) / n as f64
+                    (-above).exp() * (u / hi).powf(l) * (hi - lo) / n as f64
                 })
                 .sum();
             let b = bin_masking(lo, hi, l, above);
