@@ -149,7 +149,7 @@ mod tests {
     #[test]
     fn bins_integrate_the_visibility_exactly() {
         for l in [0.0, 0.3, 2.0, 40.0, 1e4] {
-            let (lo, hi, above) = (0.2, 0.55, 0.7);
+            let (lo, hi, above): (f64, f64, f64) = (0.2, 0.55, 0.7);
             let n = 200_000;
             let quad: f64 = (0..n)
                 .map(|k| {
