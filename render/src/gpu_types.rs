@@ -245,6 +245,15 @@ gpu_struct! {
         mix_rule_offset: u32 => "u32",
         /// n of that n × n rule; 0 when the filtered view keeps one Gaussian (no mixture).
         mix_points: u32 => "u32",
+        /// 1 when the specular lobe uses the noise's own slope density (`NoiseSlopes::Exact`),
+        /// 0 for the Gaussian.
+        noise_slopes: u32 => "u32",
+        /// Padding to WGSL's 16-byte struct size.
+        pad1: u32 => "u32",
+        /// Padding.
+        pad2: u32 => "u32",
+        /// Padding.
+        pad3: u32 => "u32",
     }
 }
 

@@ -21,6 +21,7 @@ use lodestone_core::math::piecewise::PiecewisePoly;
 use lodestone_core::microfacet::effective_height::{EffectiveHeightTable, HeightFilter};
 use lodestone_core::microfacet::height_mixture::bin_slope_points;
 use lodestone_core::microfacet::masking_shadowing::Correlation;
+use lodestone_core::microfacet::slope_density::NoiseSlopes;
 use lodestone_core::microfacet::visible_slopes::slope_rule;
 use lodestone_core::scene::bound_grid::BoundGrid;
 use lodestone_core::scene::camera::{Camera, PIXEL_SIGMA};
@@ -607,6 +608,7 @@ pub fn material_data_for(
     base.dh_offset = lay.dh;
     base.slope_rule_offset = lay.slope_rule;
     base.slope_points = points as u32;
+    base.noise_slopes = u32::from(m.filtering.noise_slopes == NoiseSlopes::Exact);
     base.cp_offset = lay.color_poly;
     base.tp_offset = lay.transfer_poly;
     base.sigma_h = s.sigma_h as f32;

@@ -27,6 +27,7 @@ pub const SPECIAL: &str = include_str!("shaders/math/special.wgsl");
 pub const MATERIAL_FILES: &[(&str, &str)] = wgsl_files![
     "bindings.wgsl",
     "math/gaussian.wgsl",
+    "math/bessel.wgsl",
     "math/piecewise.wgsl",
     "microfacet/slopes.wgsl",
     "microfacet/smith.wgsl",
@@ -34,6 +35,7 @@ pub const MATERIAL_FILES: &[(&str, &str)] = wgsl_files![
     "microfacet/effective_height.wgsl",
     "microfacet/height_mixture.wgsl",
     "microfacet/visible_slopes.wgsl",
+    "microfacet/slope_density.wgsl",
     "microfacet/brdf.wgsl",
     "microfacet/attribute.wgsl",
     "material/preconvolved.wgsl",

@@ -52,6 +52,8 @@ const MIRRORS: &[(&str, &str, &str, &str)] = &[
     ("math/special.wgsl", "norm_quantile", "math/special_f32.rs", "norm_quantile"),
     ("math/special.wgsl", "acklam", "math/special_f32.rs", "acklam"),
     ("math/special.wgsl", "lower_quantile", "math/special_f32.rs", "lower_quantile"),
+    ("microfacet/slope_density.wgsl", "unresolved_term", "driver/noise.rs", "unresolved_gradient_terms"),
+    ("eval/filtered.wgsl", "lobe_density_ratio", "eval/filtered.rs", "lobe_density_ratio"),
     ("math/piecewise.wgsl", "poly_eval", "math/piecewise.rs", "eval"),
     ("math/piecewise.wgsl", "poly_max_abs_on", "math/piecewise.rs", "max_abs_on"),
     ("microfacet/smith.wgsl", "projected_std", "microfacet/slopes.rs", "projected_std"),

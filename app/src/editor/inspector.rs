@@ -15,6 +15,7 @@ use lodestone_core::material::transfer::{SurfaceShape, TransferFunction};
 use lodestone_core::material::{ColorModel, ColorSource, Driver, Filtering, Material};
 use lodestone_core::microfacet::effective_height::HeightFilter;
 use lodestone_core::microfacet::height_mixture::TransferSlopes;
+use lodestone_core::microfacet::slope_density::NoiseSlopes;
 use lodestone_core::microfacet::masking_shadowing::Correlation;
 use std::sync::Arc;
 
@@ -702,6 +703,19 @@ fn filtering(ui: &mut Ui, f: &mut Filtering) -> bool {
         .on_hover_text("Slopes under a transfer curve g: a mixture of Gaussians over bins of the driver's value f (given f the slopes are Gaussian with std σ_h·g'(f) times the driver's gradient std), with height-dependent masking (default), or one Gaussian of the same second moment [HNPN14 Eqs. 19–26]");
     if t != f.transfer_slopes {
         f.transfer_slopes = t;
+        changed = true;
+    }
+    let mut d = f.noise_slopes;
+    egui::ComboBox::from_label("Noise slope density")
+        .selected_text(format!("{d:?}"))
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut d, NoiseSlopes::Exact, "Exact");
+            ui.selectable_value(&mut d, NoiseSlopes::Gaussian, "Gaussian");
+        })
+        .response
+        .on_hover_text("Density of the noise's unresolved slopes under the specular lobe: the sum of sinusoids' own (saddlepoint of its cumulant generating function, Σ ln I0; lighter tails than a Gaussian) or the Gaussian of the same covariance [HN12 Sec. 5.5]");
+    if d != f.noise_slopes {
+        f.noise_slopes = d;
         changed = true;
     }
     changed |= ui

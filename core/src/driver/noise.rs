@@ -241,6 +241,22 @@ impl SumOfSines {
         }
     }
 
+    /// The unresolved gradient at a footprint as a random-phase sum of sinusoids: per wave
+    /// `v_i = 2π a_i √(1 − α_i²)·k_i` (α_i its [`SumOfSines::attenuation`]), whose covariance
+    /// `Σ ½ v_i v_iᵀ` is [`SumOfSines::filtered`]'s gradient covariance. Far away (α → 0) these are
+    /// the waves' own gradients: the exact slope distribution is the density of `Σ v_i sin ψ_i`
+    /// ([`crate::microfacet::slope_density`]). Waves with nothing left unresolved are skipped.
+    pub fn unresolved_gradient_terms(&self, fp: Footprint) -> Vec<DVec2> {
+        self.waves
+            .iter()
+            .filter_map(|w| {
+                let g = self.attenuation(w, fp);
+                let r = (1.0 - g * g).max(0.0).sqrt();
+                (r > 0.0).then(|| w.k * (TAU * w.amplitude * r))
+            })
+            .collect()
+    }
+
     /// The ends of the fast march's nested octave levels
     /// ([`level_ends`]).
     pub fn level_ends(&self) -> Vec<usize> {

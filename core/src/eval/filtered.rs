@@ -8,11 +8,14 @@
 //! moment tables [HNPN14 Eqs. 21–26]; under a transfer curve the slopes are by default a mixture
 //! over the driver's value instead of one Gaussian ([`crate::eval::mixture_bins`]).
 
+use crate::driver::field::DriverField;
 use crate::eval::{Evaluator, FootprintQuery};
+use crate::material::transfer::TransferFunction;
 use crate::microfacet::brdf::filtered_specular;
 use crate::microfacet::effective_height::height_moments;
 use crate::microfacet::masking_shadowing::G2;
-use crate::microfacet::slopes::normal_of;
+use crate::microfacet::slope_density::{NoiseSlopes, sinusoid_density_ratio};
+use crate::microfacet::slopes::{normal_of, slope_of};
 use crate::scene::direction::basis;
 use glam::{DMat3, DVec2, DVec3};
 
@@ -91,8 +94,41 @@ impl Evaluator {
         // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
         let mean = loc.stats.slope_mean;
         let shading = self.visible_shading(mean, &sigma, cfg.wo, cfg.wi, frame);
-        let spec = filtered_specular(brdf.specular, brdf.roughness, mean, &sigma, cfg.wo, cfg.wi);
+        let spec = filtered_specular(brdf.specular, brdf.roughness, mean, &sigma, cfg.wo, cfg.wi)
+            * self.lobe_density_ratio(cfg, mean);
         self.radiance(sun_color, env_color, &shading, sun_visible * vbar, spec)
+    }
+}
+
+impl Evaluator {
+    /// The noise's exact unresolved slope density over the Gaussian the lobe assumes, at the half
+    /// vector's slope relative to the footprint's mean ([`sinusoid_density_ratio`], with the base
+    /// roughness as the added Gaussian): 1 for image drivers, transfer curves (their slopes are
+    /// not the waves' alone), without specular and with `filtering.noise_slopes: Gaussian`.
+    pub fn lobe_density_ratio(&self, cfg: &FootprintQuery, mean: DVec2) -> f64 {
+        let m = &self.material;
+        let DriverField::Noise(noise) = &self.surface.driver else {
+            return 1.0;
+        };
+        if m.brdf.specular <= 0.0
+            || m.filtering.noise_slopes == NoiseSlopes::Gaussian
+            || !matches!(m.heights.transfer, TransferFunction::Identity)
+            || cfg.wo.z <= 0.0
+            || cfg.wi.z <= 0.0
+        {
+            return 1.0;
+        }
+        let h = (cfg.wo + cfg.wi).normalize();
+        if !(h.z > 1e-9) {
+            return 1.0;
+        }
+        let sigma_h = self.surface.sigma_h;
+        let v: Vec<DVec2> = noise
+            .unresolved_gradient_terms(cfg.footprint)
+            .into_iter()
+            .map(|t| t * sigma_h)
+            .collect();
+        sinusoid_density_ratio(&v, m.brdf.roughness, slope_of(h) - mean)
     }
 }
 

@@ -188,6 +188,9 @@ mod tests {
         let mut lit = gaussian_material();
         lit.brdf.specular = 0.04;
         lit.brdf.roughness = 0.15;
+        // The mixture's lobes are Gaussian: compare with the model's Gaussian lobe (the noise's
+        // own slope density is checked in microfacet::slope_density).
+        lit.filtering.noise_slopes = crate::microfacet::slope_density::NoiseSlopes::Gaussian;
         lit.lighting.environment = Some(crate::material::environment::Environment {
             source: crate::material::environment::EnvironmentSource::Sky(
                 crate::material::environment::Sky::default(),

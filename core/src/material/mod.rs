@@ -33,6 +33,7 @@ use crate::microfacet::brdf::BaseBrdf;
 use crate::microfacet::effective_height::HeightFilter;
 use crate::microfacet::height_mixture::TransferSlopes;
 use crate::microfacet::masking_shadowing::Correlation;
+use crate::microfacet::slope_density::NoiseSlopes;
 use crate::microfacet::slopes::SlopeCov;
 use serde::{Deserialize, Serialize};
 
@@ -131,6 +132,8 @@ pub struct Filtering {
     pub slope_points: u32,
     /// Slopes under a transfer curve: a mixture over the driver's value (default) or one Gaussian.
     pub transfer_slopes: TransferSlopes,
+    /// The noise's slope density under the specular lobe: its own (default) or the Gaussian.
+    pub noise_slopes: NoiseSlopes,
 }
 
 impl Default for Filtering {
@@ -141,6 +144,7 @@ impl Default for Filtering {
             table: TableSpec::default(),
             slope_points: Self::DEFAULT_SLOPE_POINTS,
             transfer_slopes: TransferSlopes::default(),
+            noise_slopes: NoiseSlopes::default(),
         }
     }
 }

@@ -2,6 +2,7 @@
 //! mirror, quadrature, piecewise polynomials, spherical harmonics, Gaussian helpers and the
 //! reproducible random numbers of the Monte Carlo paths.
 
+pub mod bessel;
 pub mod gaussian;
 pub mod piecewise;
 pub mod quadrature;

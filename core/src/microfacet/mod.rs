@@ -11,6 +11,7 @@
 //! | D_h, its moments and fits | [`effective_height`] | [HNPN14 Eqs. 14–17] |
 //! | D_s, the slope rule that runs | [`visible_slopes`] | [HNPN14 Sec. 5.2] |
 //! | slopes under a transfer curve: bins, masking | [`height_mixture`] | #17, Smith 1967 |
+//! | the noise's exact slope density (saddlepoint) | [`slope_density`] | #17, Daniels 1954 |
 //! | base BRDF, filtered specular | [`brdf`] | [HN12 Sec. 5.5] |
 //! | a(h) = ā + a_s·s(h) | [`attribute`] | [HN12 Eq. 17] |
 
@@ -19,6 +20,7 @@ pub mod brdf;
 pub mod effective_height;
 pub mod height_mixture;
 pub mod masking_shadowing;
+pub mod slope_density;
 pub mod slopes;
 pub mod smith;
 pub mod visible_slopes;

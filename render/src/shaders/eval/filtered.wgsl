@@ -41,7 +41,7 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
     // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
     let s_mean = loc.stats.slope_mean;
     let shading = visible_shading(s_mean, cov, wo_w, wi_w);
-    let spec = filtered_specular(s_mean, cov, wo_w, wi_w);
+    let spec = filtered_specular(s_mean, cov, wo_w, wi_w) * lobe_density_ratio(fp, s_mean, wo_w, wi_w);
     return radiance(sun_color, env_color, shading, sun_visible * vbar, spec);
 //#else
     // Flat: every facet faces +z, nothing masks or shadows (Λ = 0, and D_h at L = 0 is the
@@ -54,6 +54,23 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
     let spec = filtered_specular(vec2<f32>(0.0), vec3<f32>(0.0), wo_w, wi_w);
     return radiance(aff, aff, point_shading(vec3<f32>(0.0, 0.0, 1.0), wi_w), sun_visible * select(0.0, 1.0, wi_w.z > 0.0), spec);
 //#endif
+}
+
+// Evaluator::lobe_density_ratio: the noise's own unresolved slope density over the Gaussian at
+// the half vector (1 for images, transfer curves, no specular, or noise_slopes Gaussian).
+fn lobe_density_ratio(fp: vec3<f32>, s_mean: vec2<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+//#if noise
+//#if specular
+    if (params.driver_kind != DRIVER_IMAGE && params.specular > 0.0 && params.noise_slopes != 0u
+        && params.transfer_kind == TRANSFER_IDENTITY && wo.z > 0.0 && wi.z > 0.0) {
+        let h = normalize(wo + wi);
+        if (h.z > 1e-9) {
+            return sinusoid_density_ratio(slope_of(h) - s_mean, params.roughness, fp);
+        }
+    }
+//#endif
+//#endif
+    return 1.0;
 }
 
 // above_horizon: ω kept at least MIN_VIEW_COS above the mean plane's horizon.
