@@ -15,8 +15,8 @@ use lodestone_core::material::transfer::{SurfaceShape, TransferFunction};
 use lodestone_core::material::{ColorModel, ColorSource, Driver, Filtering, Material};
 use lodestone_core::microfacet::effective_height::HeightFilter;
 use lodestone_core::microfacet::height_mixture::TransferSlopes;
-use lodestone_core::microfacet::slope_density::NoiseSlopes;
 use lodestone_core::microfacet::masking_shadowing::Correlation;
+use lodestone_core::microfacet::slope_density::NoiseSlopes;
 use std::sync::Arc;
 
 /// UI state of the inspector.
