@@ -46,6 +46,8 @@ pub mod view_independent;
 #[cfg(test)]
 mod independent;
 #[cfg(test)]
+mod measurements;
+#[cfg(test)]
 pub(crate) mod test_materials;
 #[cfg(test)]
 mod tests;
