@@ -9,6 +9,28 @@ use crate::scene::direction::direction;
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
 
+/// A preset of the library by name, parsed.
+fn preset(name: &str) -> Material {
+    let text = std::fs::read_to_string(format!(
+        "{}/../presets/{name}.ron",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .expect("preset");
+    Material::from_ron(&text).expect("valid")
+}
+
+/// The signed relative error (%) of the channel farthest from `truth`, and the truth's largest
+/// relative standard error (%).
+fn worst_error(v: [f64; 3], truth: &crate::eval::Estimate) -> (f64, f64) {
+    let rel = (0..3)
+        .map(|k| 100.0 * (v[k] - truth.mean[k]) / truth.mean[k])
+        .fold(0.0f64, |a, e| if e.abs() > a.abs() { e } else { a });
+    let se = (0..3)
+        .map(|k| 100.0 * truth.std_error[k] / truth.mean[k])
+        .fold(0.0f64, f64::max);
+    (rel, se)
+}
+
 /// Why the specular lobe is off in the slope distribution's tails (#17, bumpy-specular): the
 /// density of the noise's slopes (σ_h ∇f of a sum of sinusoids, phases uniform: the footprint's
 /// statistics far away) at the half vectors of the failing configurations, by Monte Carlo over the
@@ -18,12 +40,7 @@ use std::f64::consts::PI;
 #[ignore = "a measurement for the closing note, prints a table"]
 fn slope_density_of_the_noise_in_its_tails() {
     use crate::microfacet::slopes::slope_of;
-    let text = std::fs::read_to_string(format!(
-        "{}/../presets/bumpy-specular.ron",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .expect("preset");
-    let m = Material::from_ron(&text).expect("valid");
+    let m = preset("bumpy-specular");
     let noise = m.noise().expect("a noise driver");
     let sh = m.heights.sigma_h;
     // Slope contributions c_i k̂_i sin ψ_i, c_i = σ_h 2π a_i |k_i|.
@@ -108,12 +125,7 @@ fn slope_density_of_the_noise_in_its_tails() {
 fn transfer_presets_against_ground_truth() {
     use crate::microfacet::height_mixture::TransferSlopes;
     for name in ["moss", "sponge", "terraces"] {
-        let text = std::fs::read_to_string(format!(
-            "{}/../presets/{name}.ron",
-            env!("CARGO_MANIFEST_DIR")
-        ))
-        .expect("preset");
-        let m = Material::from_ron(&text).expect("valid");
+        let m = preset(name);
         let p = Evaluator::new(&m).expect("prepared");
         let mut g = m.clone();
         g.filtering.transfer_slopes = TransferSlopes::Gaussian;
@@ -133,14 +145,8 @@ fn transfer_presets_against_ground_truth() {
             };
             let cfg = FootprintQuery::far(&p, direction(f64::to_radians(view), 0.0), wi);
             let gt = p.ground_truth(&cfg, 200_000, 41);
-            let rel = |v: [f64; 3]| {
-                (0..3)
-                    .map(|k| 100.0 * (v[k] - gt.mean[k]) / gt.mean[k])
-                    .fold(0.0f64, |a, e| if e.abs() > a.abs() { e } else { a })
-            };
-            let se = (0..3)
-                .map(|k| 100.0 * gt.std_error[k] / gt.mean[k])
-                .fold(0.0f64, f64::max);
+            let rel = |v: [f64; 3]| worst_error(v, &gt).0;
+            let se = worst_error(gt.mean, &gt).1;
             eprintln!(
                 "{name:9} view {view:2} light {light:2}/{az:3}: bins {:+6.2}%  gaussian {:+6.2}%  fine {:+6.2}%  (truth s.e. {se:.2}%)",
                 rel(p.filtered(&cfg)),
@@ -164,12 +170,7 @@ fn grazing_specular_decomposition() {
     use crate::microfacet::brdf::filtered_specular;
     use crate::microfacet::masking_shadowing::G2;
     use crate::microfacet::slopes::{SlopeCov, normal_of};
-    let text = std::fs::read_to_string(format!(
-        "{}/../presets/bumpy-specular.ron",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .expect("preset");
-    let m = Material::from_ron(&text).expect("valid");
+    let m = preset("bumpy-specular");
     let p = Evaluator::new(&m).expect("prepared");
     let s = &p.surface;
     let n_points = 400_000;
@@ -245,12 +246,7 @@ fn grazing_specular_decomposition() {
 fn specular_presets_against_ground_truth() {
     use crate::microfacet::slope_density::NoiseSlopes;
     for name in ["bumpy-specular", "default", "snake-skin"] {
-        let text = std::fs::read_to_string(format!(
-            "{}/../presets/{name}.ron",
-            env!("CARGO_MANIFEST_DIR")
-        ))
-        .expect("preset");
-        let m = Material::from_ron(&text).expect("valid");
+        let m = preset(name);
         if m.brdf.specular <= 0.0 {
             eprintln!("{name}: no specular");
             continue;
@@ -277,14 +273,8 @@ fn specular_presets_against_ground_truth() {
             };
             let cfg = FootprintQuery::far(&p, direction(f64::to_radians(view), 0.0), wi);
             let gt = p.ground_truth(&cfg, 400_000, 47);
-            let rel = |v: [f64; 3]| {
-                (0..3)
-                    .map(|k| 100.0 * (v[k] - gt.mean[k]) / gt.mean[k])
-                    .fold(0.0f64, |a, e| if e.abs() > a.abs() { e } else { a })
-            };
-            let se = (0..3)
-                .map(|k| 100.0 * gt.std_error[k] / gt.mean[k])
-                .fold(0.0f64, f64::max);
+            let rel = |v: [f64; 3]| worst_error(v, &gt).0;
+            let se = worst_error(gt.mean, &gt).1;
             eprintln!(
                 "{name:15} view {view:2} light {light:2}/{az:3}: exact {:+7.2}%  gaussian {:+7.2}%  (truth s.e. {se:.2}%)",
                 rel(p.filtered(&cfg)),
