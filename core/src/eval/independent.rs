@@ -255,12 +255,7 @@ fn transfer_presets_filter_to_ground_truth() {
         ("terraces", 30.0, 30.0, 180.0),
         ("terraces", 60.0, 30.0, 0.0),
     ] {
-        let text = std::fs::read_to_string(format!(
-            "{}/../presets/{name}.ron",
-            env!("CARGO_MANIFEST_DIR")
-        ))
-        .expect("preset");
-        let p = Evaluator::new(&Material::from_ron(&text).expect("valid")).expect("prepared");
+        let p = Evaluator::new(&crate::eval::test_materials::preset(name)).expect("prepared");
         let wi = direction(f64::to_radians(light), f64::to_radians(az));
         let cfg = FootprintQuery::far(&p, direction(f64::to_radians(view), 0.0), wi);
         let gt = p.ground_truth(&cfg, 20_000, 43);

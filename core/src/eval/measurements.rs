@@ -3,21 +3,11 @@
 //! density in its tails, the transfer-curve and specular presets against the ray-traced truth, and
 //! where the grazing specular error lives on the explicit surface.
 
+use crate::eval::test_materials::preset;
 use crate::eval::{Evaluator, FootprintQuery};
-use crate::material::Material;
 use crate::scene::direction::direction;
 use glam::{DVec2, DVec3};
 use std::f64::consts::PI;
-
-/// A preset of the library by name, parsed.
-fn preset(name: &str) -> Material {
-    let text = std::fs::read_to_string(format!(
-        "{}/../presets/{name}.ron",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .expect("preset");
-    Material::from_ron(&text).expect("valid")
-}
 
 /// The signed relative error (%) of the channel farthest from `truth`, and the truth's largest
 /// relative standard error (%).

@@ -283,20 +283,11 @@ mod tests {
 
 #[cfg(test)]
 mod binning {
+    use crate::eval::test_materials::preset;
     use crate::eval::{Evaluator, FootprintQuery};
-    use crate::material::Material;
     use crate::microfacet::height_mixture::TransferSlopes;
     use crate::scene::direction::direction;
     use glam::DVec3;
-
-    fn preset(name: &str) -> Material {
-        let text = std::fs::read_to_string(format!(
-            "{}/../presets/{name}.ron",
-            env!("CARGO_MANIFEST_DIR")
-        ))
-        .expect("preset");
-        Material::from_ron(&text).expect("valid")
-    }
 
     /// Signed relative error of `v` against `fine`, the channel farthest off, in %.
     fn worst(v: [f64; 3], fine: [f64; 3]) -> f64 {

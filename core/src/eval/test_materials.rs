@@ -46,3 +46,13 @@ pub(crate) fn far_patch(wo: glam::DVec3, wi: glam::DVec3) -> crate::eval::Footpr
         footprint: crate::driver::footprint::Footprint::isotropic(40.0),
     }
 }
+
+/// A preset of the library by name (`"moss"`), parsed.
+pub(crate) fn preset(name: &str) -> Material {
+    let text = std::fs::read_to_string(format!(
+        "{}/../presets/{name}.ron",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .expect("preset");
+    Material::from_ron(&text).expect("valid")
+}
