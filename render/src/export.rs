@@ -8,6 +8,7 @@
 //! | `params.bin` | the material's WGSL `Params` struct (std430, little-endian) for binding 0 |
 //! | `data.bin` | the material's f32 data buffer (waves, tables, D_h, quadrature rule) for binding 1 |
 //! | `color_table.exr`, `transfer_table.exr`, `effective_height.exr` | the pre-convolved tables as images, for engines that prefer textures |
+//! | `histogram_table.exr` | image drivers with a kept histogram: H(f̄, σ_f) = (μ_G, σ_G), the colour table is then indexed by it |
 //! | `manifest.json` | sizes, ranges and indexing of every table, every `Params` field by name, the API |
 //! | `material.ron` | the preset |
 //!
@@ -209,6 +210,22 @@ pub fn bundle(prepared: &Evaluator) -> Result<Vec<(String, Vec<u8>)>, ExportErro
                 "color_table.exr",
                 ["R", "G", "B", "unused"],
                 params.ct_offset,
+            ),
+        );
+    }
+    if let Some(t) = prepared.color.gaussianize_table() {
+        // The colour table is then indexed by the image histogram's Gaussian space (μ_G, σ_G).
+        files.push((
+            "histogram_table.exr".into(),
+            table_exr("histogram_table.exr", t)?,
+        ));
+        tables.insert(
+            "histogram".into(),
+            table_json(
+                t,
+                "histogram_table.exr",
+                ["mean G", "std G", "unused", "unused"],
+                params.ht_offset,
             ),
         );
     }

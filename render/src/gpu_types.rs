@@ -248,12 +248,20 @@ gpu_struct! {
         /// 1 when the specular lobe uses the noise's own slope density (`NoiseSlopes::Exact`),
         /// 0 for the Gaussian.
         noise_slopes: u32 => "u32",
+        /// Offset of the image histogram's table H (f̄, σ_f) → (μ_G, σ_G).
+        ht_offset: u32 => "u32",
+        /// Table H size along the mean; 0 when the colour table is over the driver's value.
+        ht_size_m: u32 => "u32",
+        /// Table H size along σ.
+        ht_size_s: u32 => "u32",
+        /// Table H's smallest mean.
+        ht_m_min: f32 => "f32",
+        /// Table H's largest mean.
+        ht_m_max: f32 => "f32",
+        /// Table H's largest σ.
+        ht_sigma_max: f32 => "f32",
         /// Padding to WGSL's 16-byte struct size.
         pad1: u32 => "u32",
-        /// Padding.
-        pad2: u32 => "u32",
-        /// Padding.
-        pad3: u32 => "u32",
     }
 }
 

@@ -495,6 +495,17 @@ pub fn material_data_for(
         base.ct_m_max = t.m_max as f32;
         base.ct_sigma_max = t.sigma_max as f32;
     }
+    if let Some(t) = prepared.color.gaussianize_table() {
+        // The colour table is over the image histogram's Gaussian space: H maps (f̄, σ_f) there.
+        let start = data.len();
+        base.ht_offset = push_table(&mut data, t);
+        mark(&data, start, "histogram table H");
+        base.ht_size_m = t.size_m as u32;
+        base.ht_size_s = t.size_sigma as u32;
+        base.ht_m_min = t.m_min as f32;
+        base.ht_m_max = t.m_max as f32;
+        base.ht_sigma_max = t.sigma_max as f32;
+    }
     if let Some(t) = prepared.transfer.table() {
         let start = data.len();
         lay.transfer_table = push_table(&mut data, t);

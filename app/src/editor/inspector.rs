@@ -4,6 +4,7 @@
 use super::curve_editor::CurveEditor;
 use super::gradient_editor::GradientEditor;
 use egui::{Slider, Ui};
+use lodestone_core::driver::histogram::ImageHistogram;
 use lodestone_core::driver::image::ImageDriver;
 use lodestone_core::driver::noise::NoiseParams;
 use lodestone_core::material::color_terms::{CombineMode, ConstantTerm, SlopeTerm};
@@ -662,6 +663,19 @@ fn transfer_model_note(ui: &mut Ui, m: &Material) {
         format!("Slopes: one Gaussian ({why})")
     };
     ui.weak(text);
+    if matches!(m.driver, Driver::Image { .. }) {
+        let text = if features.contains(Feature::ImageHistogram) {
+            "Image values: the image's own histogram, moment-matched per footprint".to_owned()
+        } else {
+            let why = features
+                .absent(m)
+                .into_iter()
+                .find(|(f, _)| *f == Feature::ImageHistogram)
+                .map_or("", |(_, why)| why);
+            format!("Image values: one Gaussian ({why})")
+        };
+        ui.weak(text);
+    }
 }
 
 fn filtering(ui: &mut Ui, f: &mut Filtering) -> bool {
@@ -716,6 +730,19 @@ fn filtering(ui: &mut Ui, f: &mut Filtering) -> bool {
         .on_hover_text("Density of the noise's unresolved slopes under the specular lobe: the sum of sinusoids' own (saddlepoint of its cumulant generating function, Σ ln I0; lighter tails than a Gaussian) or the Gaussian of the same covariance [HN12 Sec. 5.5]");
     if d != f.noise_slopes {
         f.noise_slopes = d;
+        changed = true;
+    }
+    let mut ih = f.image_histogram;
+    egui::ComboBox::from_label("Image histogram")
+        .selected_text(format!("{ih:?}"))
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut ih, ImageHistogram::Preserving, "Preserving");
+            ui.selectable_value(&mut ih, ImageHistogram::Gaussian, "Gaussian");
+        })
+        .response
+        .on_hover_text("An image driver's values inside a footprint: the image's own histogram: the inverse of its Gaussianizing transfer T applied to N(μ_G, σ_G²), moment-matched to the footprint's mean and std, with the colour map pre-convolved over G (default), or a Gaussian of the footprint's mean and std [HNPN14 Sec. 4.2; Heitz & Neyret 2018]");
+    if ih != f.image_histogram {
+        f.image_histogram = ih;
         changed = true;
     }
     changed |= ui

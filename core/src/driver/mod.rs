@@ -4,8 +4,11 @@
 
 pub mod field;
 pub mod footprint;
+pub mod histogram;
 pub mod image;
 pub mod noise;
+#[cfg(test)]
+pub mod test_images;
 
 /// Errors building a material's driver.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]

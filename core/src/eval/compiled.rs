@@ -2,6 +2,7 @@
 //! closed enums that own what their variant needs: a gradient colour model owns its pre-convolved
 //! table, a transfer curve owns its moment table. No "table is missing" state exists.
 
+use crate::driver::histogram::{DriverHistogram, MU_RANGE, SIGMA_G_MAX};
 use crate::eval::query::FootprintStats;
 use crate::material::colormap::Gradient;
 use crate::material::preconvolved::{PreconvolvedTable, TableSpec};
@@ -20,8 +21,12 @@ pub enum CompiledColor {
         map: Gradient,
         /// What indexes it.
         source: ColorSource,
-        /// Its pre-convolved table (filtered lookups).
+        /// Its pre-convolved table (filtered lookups): over the driver's value, or over the
+        /// Gaussian space of an image's histogram when `gaussianize` is present.
         table: PreconvolvedTable,
+        /// For an image driver whose histogram is kept ([`crate::driver::histogram`]): the table
+        /// `H(f̄, σ_f) = (μ_G, σ_G)`; `table` is then `C∘T⁻¹` pre-convolved over G.
+        gaussianize: Option<PreconvolvedTable>,
     },
     /// The attribute model `a(h) = ā + a_s·s(h)` [HN12 Eq. 17].
     Attribute {
@@ -33,13 +38,35 @@ pub enum CompiledColor {
 }
 
 impl CompiledColor {
-    /// Compile a colour model, building a gradient's table at `spec`.
-    pub fn new(model: &ColorModel, spec: TableSpec) -> Self {
+    /// Compile a colour model, building a gradient's table at `spec`; with an image's
+    /// `histogram`, over the histogram's Gaussian space (μ_G ∈ ±[`MU_RANGE`], σ_G ≤
+    /// [`SIGMA_G_MAX`], `spec`'s sizes).
+    pub fn new(model: &ColorModel, spec: TableSpec, histogram: Option<&DriverHistogram>) -> Self {
         match model {
-            ColorModel::Gradient { map, source } => Self::Gradient {
-                map: map.clone(),
-                source: *source,
-                table: map.preconvolve(spec),
+            ColorModel::Gradient { map, source } => match histogram {
+                None => Self::Gradient {
+                    map: map.clone(),
+                    source: *source,
+                    table: map.preconvolve(spec),
+                    gaussianize: None,
+                },
+                Some(h) => {
+                    let composed = h.compose(&map.to_piecewise());
+                    let g_spec = TableSpec {
+                        sigma_max: SIGMA_G_MAX,
+                        ..spec
+                    };
+                    let table =
+                        PreconvolvedTable::build(&composed, g_spec, (-MU_RANGE, MU_RANGE), |e| {
+                            [e[0] as f32, e[1] as f32, e[2] as f32, 1.0]
+                        });
+                    Self::Gradient {
+                        map: map.clone(),
+                        source: *source,
+                        table,
+                        gaussianize: Some(h.gaussianize_table()),
+                    }
+                }
             },
             ColorModel::Attribute { mean, correlation } => Self::Attribute {
                 mean: *mean,
@@ -52,6 +79,15 @@ impl CompiledColor {
     pub fn table(&self) -> Option<&PreconvolvedTable> {
         match self {
             Self::Gradient { table, .. } => Some(table),
+            Self::Attribute { .. } => None,
+        }
+    }
+
+    /// The table from the footprint's (f̄, σ_f) to the histogram's Gaussian space (gradients of
+    /// an image driver whose histogram is kept).
+    pub fn gaussianize_table(&self) -> Option<&PreconvolvedTable> {
+        match self {
+            Self::Gradient { gaussianize, .. } => gaussianize.as_ref(),
             Self::Attribute { .. } => None,
         }
     }
@@ -80,12 +116,20 @@ impl CompiledColor {
 
     /// The colour input's distribution within the footprint before masking, (mean, std): the
     /// driver's, or the transformed height's standardized by `global_height` (mean, std of g(f),
-    /// f ~ N(0, 1)).
+    /// f ~ N(0, 1)); with an image's histogram, mapped to its Gaussian space by the table H
+    /// (`(μ_G, σ_G)`, what the colour table is indexed by then).
     pub fn input_distribution(&self, loc: &FootprintStats, (gm, gs): (f64, f64)) -> (f64, f64) {
-        if self.indexed_by_driver() {
+        let (m, s) = if self.indexed_by_driver() {
             (loc.driver.mean, loc.driver.std)
         } else {
             ((loc.transfer.mean - gm) / gs, loc.transfer.std / gs)
+        };
+        match self.gaussianize_table() {
+            Some(h) => {
+                let v = h.sample(m, s);
+                (v[0], v[1].max(0.0))
+            }
+            None => (m, s),
         }
     }
 

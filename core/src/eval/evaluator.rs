@@ -4,6 +4,7 @@
 
 use crate::driver::DriverError;
 use crate::driver::field::DriverField;
+use crate::driver::histogram::DriverHistogram;
 use crate::driver::image::ImageDriver;
 use crate::eval::compiled::{CompiledColor, CompiledTransfer};
 use crate::material::Material;
@@ -61,9 +62,24 @@ impl Evaluator {
         let surface = Surface::with_driver(material, DriverField::new(material, image)?);
         let spec = material.filtering.table;
         let same_spec = previous.is_some_and(|p| p.material.filtering.table == spec);
+        // The histogram depends on the image; whether it is used, on the material.
+        let histogram = material.image_histogram();
+        let same_histogram = previous.is_some_and(|p| {
+            p.material.image_histogram() == histogram
+                && (!histogram || p.material.driver == material.driver)
+        });
         let color = match previous {
-            Some(p) if same_spec && p.material.color == material.color => p.color.clone(),
-            _ => CompiledColor::new(&material.color, spec),
+            Some(p) if same_spec && same_histogram && p.material.color == material.color => {
+                p.color.clone()
+            }
+            _ => {
+                let h = surface
+                    .driver
+                    .image()
+                    .filter(|_| histogram)
+                    .map(|t| DriverHistogram::of_image(&t.image));
+                CompiledColor::new(&material.color, spec, h.as_ref())
+            }
         };
         let transfer = match previous {
             Some(p) if same_spec && p.material.heights.transfer == material.heights.transfer => {

@@ -14,6 +14,7 @@
 //! driver (a finite set of waves or an image is never exactly isotropic), so the general path is
 //! the only path.
 
+use crate::driver::histogram::ImageHistogram;
 use crate::material::transfer::TransferFunction;
 use crate::material::{ColorModel, ColorSource, Driver, Material};
 use crate::scene::shape::Shape;
@@ -55,11 +56,15 @@ pub enum Feature {
     SlopeColor,
     /// Environment lighting: SH9 irradiance per facet, averaged over D_s [HNPN14 Sec. 5.3].
     Environment,
+    /// An image driver's histogram kept by the colour map's filtering: the table from the
+    /// footprint's (f̄, σ_f) to Gaussian space and the colour table over it
+    /// ([`crate::driver::histogram`]; needs an image and a gradient colour map).
+    ImageHistogram,
 }
 
 impl Feature {
     /// Every feature, in a fixed order.
-    pub const ALL: [Feature; 13] = [
+    pub const ALL: [Feature; 14] = [
         Feature::NoiseDriver,
         Feature::ImageDriver,
         Feature::DriverColor,
@@ -73,6 +78,7 @@ impl Feature {
         Feature::Curved,
         Feature::SlopeColor,
         Feature::Environment,
+        Feature::ImageHistogram,
     ];
 
     /// The name used in shader directives (`//#if relief`), the CLI and JSON.
@@ -91,6 +97,7 @@ impl Feature {
             Feature::Curved => "curved",
             Feature::SlopeColor => "slope_color",
             Feature::Environment => "environment",
+            Feature::ImageHistogram => "image_histogram",
         }
     }
 
@@ -146,15 +153,20 @@ impl FeatureSet {
 
     /// The set with the implications between features applied: shadows need relief (a flat
     /// plane casts none; the shadow march needs the level-of-detail surface); the transfer
-    /// mixture needs relief and a transfer curve.
+    /// mixture needs relief and a transfer curve; the image histogram needs an image and a
+    /// gradient colour map.
     #[must_use]
     pub fn normalized(self) -> FeatureSet {
         let relief = self.contains(Feature::Relief);
         let mixture = relief
             && self.contains(Feature::TransferCurve)
             && self.contains(Feature::TransferMixture);
+        let histogram = self.contains(Feature::ImageHistogram)
+            && self.contains(Feature::ImageDriver)
+            && (self.contains(Feature::DriverColor) || self.contains(Feature::HeightColor));
         self.with(Feature::Shadows, relief && self.contains(Feature::Shadows))
             .with(Feature::TransferMixture, mixture)
+            .with(Feature::ImageHistogram, histogram)
     }
 
     /// The features of the material alone (no scene): see [`FeatureSet::derive`].
@@ -202,6 +214,7 @@ impl FeatureSet {
             .with(Feature::Specular, m.brdf.specular > 0.0)
             .with(Feature::SlopeColor, m.terms.slope.is_some())
             .with(Feature::Environment, m.lighting.environment.is_some())
+            .with(Feature::ImageHistogram, colour_model && m.image_histogram())
     }
 
     /// The features a material needs in a scene with this object and light (unit direction
@@ -276,6 +289,19 @@ impl FeatureSet {
                     Feature::Curved => "the scene is the plane",
                     Feature::SlopeColor => "the material has no slope colour term",
                     Feature::Environment => "the lighting has no environment",
+                    Feature::ImageHistogram => {
+                        if !matches!(m.driver, Driver::Image { .. }) {
+                            "the noise is Gaussian at every scale"
+                        } else if !m.terms.uses_height_term()
+                            || matches!(m.color, ColorModel::Attribute { .. })
+                        {
+                            "no gradient colour map of the image's value"
+                        } else if m.filtering.image_histogram == ImageHistogram::Gaussian {
+                            "filtering.image_histogram is Gaussian (the papers' model)"
+                        } else {
+                            "the colour map is indexed by a transformed height"
+                        }
+                    }
                 };
                 (f, why)
             })

@@ -22,6 +22,7 @@ pub mod slope_color;
 pub mod transfer;
 pub mod validation;
 
+use crate::driver::histogram::ImageHistogram;
 use crate::driver::noise::{NoiseParams, SumOfSines};
 use crate::material::color_terms::ColorTerms;
 use crate::material::colormap::Gradient;
@@ -134,6 +135,8 @@ pub struct Filtering {
     pub transfer_slopes: TransferSlopes,
     /// The noise's slope density under the specular lobe: its own (default) or the Gaussian.
     pub noise_slopes: NoiseSlopes,
+    /// An image driver's footprint values: its own histogram (default) or the Gaussian.
+    pub image_histogram: ImageHistogram,
 }
 
 impl Default for Filtering {
@@ -145,6 +148,7 @@ impl Default for Filtering {
             slope_points: Self::DEFAULT_SLOPE_POINTS,
             transfer_slopes: TransferSlopes::default(),
             noise_slopes: NoiseSlopes::default(),
+            image_histogram: ImageHistogram::default(),
         }
     }
 }
@@ -254,6 +258,22 @@ impl Material {
         self.heights.sigma_h > 0.0
             && matches!(self.heights.transfer, TransferFunction::Curve(_))
             && self.filtering.transfer_slopes == TransferSlopes::Mixture
+    }
+
+    /// Whether the filtered view keeps an image driver's histogram
+    /// ([`crate::driver::histogram`]): an image driver under a gradient colour map indexed by the
+    /// driver value (or by height under the identity transfer, the same standardized value), with
+    /// [`ImageHistogram::Preserving`].
+    pub fn image_histogram(&self) -> bool {
+        matches!(self.driver, Driver::Image { .. })
+            && self.filtering.image_histogram == ImageHistogram::Preserving
+            && match &self.color {
+                ColorModel::Gradient { source, .. } => {
+                    *source == ColorSource::Driver
+                        || matches!(self.heights.transfer, TransferFunction::Identity)
+                }
+                ColorModel::Attribute { .. } => false,
+            }
     }
 
     /// Parse RON, then validate. Errors carry line and column where the parser has them.

@@ -140,6 +140,112 @@ impl PiecewisePoly {
             .unwrap_or(0)
     }
 
+    /// `p(L(x))` for `L` the piecewise-linear interpolant of `(xs, ys)`, `ys` non-decreasing and
+    /// `L` constant beyond the ends: exact, of p's degree, on the knots `xs` plus the preimages of
+    /// p's knots inside each rising segment (a flat segment of L is p's constant value there, a
+    /// jump of p stays a jump). What folds a histogram transfer `T⁻¹` into a colour map
+    /// ([`crate::driver::histogram`]). Empty or mismatched `xs`/`ys` give p's left value.
+    pub fn compose_linear(&self, xs: &[f64], ys: &[f64]) -> PiecewisePoly {
+        let ch = self.channels;
+        let mut value = vec![0.0; ch];
+        let mut at = |y: f64| {
+            self.eval(y, &mut value);
+            value.clone()
+        };
+        if xs.is_empty() || xs.len() != ys.len() {
+            let left = at(f64::NEG_INFINITY);
+            return PiecewisePoly {
+                knots: Vec::new(),
+                channels: ch,
+                coeffs: Vec::new(),
+                left: left.clone(),
+                right: left,
+            };
+        }
+        let (left, right) = (at(ys[0]), at(ys[ys.len() - 1]));
+        let mut knots = vec![xs[0]];
+        let mut coeffs = Vec::new();
+        for i in 0..xs.len() - 1 {
+            let (xa, xb, ya, yb) = (xs[i], xs[i + 1], ys[i], ys[i + 1]);
+            if !(xb > xa) {
+                continue;
+            }
+            // Break points in y: the segment's ends and p's knots strictly inside.
+            let mut ybreaks = vec![ya];
+            if yb > ya {
+                ybreaks.extend(self.knots.iter().copied().filter(|k| *k > ya && *k < yb));
+                ybreaks.dedup();
+            }
+            ybreaks.push(yb);
+            for w in ybreaks.windows(2) {
+                let (y0, y1) = (w[0], w[1]);
+                let x0 = if yb > ya {
+                    xa + (y0 - ya) / (yb - ya) * (xb - xa)
+                } else {
+                    xa
+                };
+                let x1 = if yb > ya {
+                    xa + (y1 - ya) / (yb - ya) * (xb - xa)
+                } else {
+                    xb
+                };
+                if !(x1 > x0) {
+                    continue;
+                }
+                self.push_composed(y0, y1, &mut coeffs);
+                knots.push(x1);
+            }
+        }
+        PiecewisePoly {
+            knots,
+            channels: ch,
+            coeffs,
+            left,
+            right,
+        }
+    }
+
+    /// The coefficients (in the local variable u ∈ [0, 1]) of `p(y0 + (y1 − y0)·u)` on a span of y
+    /// inside one of p's segments or tails, pushed channel by channel.
+    fn push_composed(&self, y0: f64, y1: f64, coeffs: &mut Vec<[f64; NCOEF]>) {
+        let n = self.knots.len();
+        let mid = 0.5 * (y0 + y1);
+        if n < 2 || !(mid >= self.knots[0]) || mid >= self.knots[n - 1] {
+            let tail = if n > 0 && mid >= self.knots[n - 1] {
+                &self.right
+            } else {
+                &self.left
+            };
+            for v in tail {
+                let mut c = [0.0; NCOEF];
+                c[0] = *v;
+                coeffs.push(c);
+            }
+            return;
+        }
+        let seg = (self.knots.partition_point(|k| *k <= mid) - 1).min(n - 2);
+        let (a, h) = (self.knots[seg], self.knots[seg + 1] - self.knots[seg]);
+        // t = (y − a)/h = α + β·u.
+        let (alpha, beta) = ((y0 - a) / h, (y1 - y0) / h);
+        for chn in 0..self.channels {
+            let src = &self.coeffs[seg * self.channels + chn];
+            let mut c = [0.0; NCOEF];
+            // Σ_k src_k (α + βu)^k by Horner in polynomials of u.
+            for &sk in src.iter().rev() {
+                let mut next = [0.0; NCOEF];
+                for j in 0..NCOEF {
+                    next[j] += c[j] * alpha;
+                    if j + 1 < NCOEF {
+                        next[j + 1] += c[j] * beta;
+                    }
+                }
+                next[0] += sk;
+                c = next;
+            }
+            coeffs.push(c);
+        }
+    }
+
     fn expectation_with(
         &self,
         m: f64,

@@ -46,8 +46,15 @@ fn color_of_distribution(mean: f32, sd: f32, l: f32, far: vec2<f32>, w: f32) -> 
 
 // CompiledColor::input_distribution.
 fn input_distribution(loc: FootprintStats) -> vec2<f32> {
+    var ms = vec2<f32>((loc.transfer.mean - params.g_mean) / params.g_std, loc.transfer.std_dev / params.g_std);
     if (params.color_kind == COLOR_DRIVER) {
-        return vec2<f32>(loc.driver.mean, loc.driver.std_dev);
+        ms = vec2<f32>(loc.driver.mean, loc.driver.std_dev);
     }
-    return vec2<f32>((loc.transfer.mean - params.g_mean) / params.g_std, loc.transfer.std_dev / params.g_std);
+//#if image_histogram
+    if (params.ht_size_m > 0u) {
+        let v = table_sample(params.ht_offset, params.ht_size_m, params.ht_size_s, params.ht_m_min, params.ht_m_max, params.ht_sigma_max, ms.x, ms.y);
+        return vec2<f32>(v.x, max(v.y, 0.0));
+    }
+//#endif
+    return ms;
 }
