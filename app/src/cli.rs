@@ -159,7 +159,8 @@ pub enum Command {
         /// The object: the plane, or a cylinder of radius 2.
         #[arg(long, value_enum, default_value_t = ShapeArg::Plane)]
         shape: ShapeArg,
-        /// Also compile and time both pipelines on the GPU adapter (view 60°, distance 6).
+        /// Also compile and time both pipelines on the GPU adapter (view 60°, distance 6). On a software
+        /// adapter (llvmpipe) the all-features pipeline takes many minutes to compile.
         #[arg(long)]
         time: bool,
         /// Image size for --time, WxH.
