@@ -652,29 +652,29 @@ fn lighting(ui: &mut Ui, l: &mut Lighting) -> bool {
 /// inspect` gives).
 fn transfer_model_note(ui: &mut Ui, m: &Material) {
     let features = FeatureSet::of_material(m);
-    let text = if features.contains(Feature::TransferMixture) {
-        "Slopes: mixture over the driver's value (a transfer curve on relief)".to_owned()
-    } else {
-        let why = features
-            .absent(m)
-            .into_iter()
-            .find(|(f, _)| *f == Feature::TransferMixture)
-            .map_or("", |(_, why)| why);
-        format!("Slopes: one Gaussian ({why})")
-    };
-    ui.weak(text);
-    if matches!(m.driver, Driver::Image { .. }) {
-        let text = if features.contains(Feature::ImageHistogram) {
-            "Image values: the image's own histogram, moment-matched per footprint".to_owned()
+    let note = |feature: Feature, on: &str, off: &str| {
+        if features.contains(feature) {
+            on.to_owned()
         } else {
             let why = features
                 .absent(m)
                 .into_iter()
-                .find(|(f, _)| *f == Feature::ImageHistogram)
+                .find(|(f, _)| *f == feature)
                 .map_or("", |(_, why)| why);
-            format!("Image values: one Gaussian ({why})")
-        };
-        ui.weak(text);
+            format!("{off} ({why})")
+        }
+    };
+    ui.weak(note(
+        Feature::TransferMixture,
+        "Slopes: mixture over the driver's value (a transfer curve on relief)",
+        "Slopes: one Gaussian",
+    ));
+    if matches!(m.driver, Driver::Image { .. }) {
+        ui.weak(note(
+            Feature::ImageHistogram,
+            "Image values: the image's own histogram, moment-matched per footprint",
+            "Image values: one Gaussian",
+        ));
     }
 }
 
