@@ -136,6 +136,29 @@ pub enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// The popping figure: a slow dolly (the editor's zoom sweep, geometric in distance) with the
+    /// fast and the reference march; per pixel, the jump between consecutive frames of each
+    /// analytic view, and how much more any pixel jumps under the fast march.
+    Dolly {
+        /// Camera angle from the normal, degrees (0 to 89.5).
+        #[arg(long, default_value_t = 77.0, value_parser = view_angle)]
+        view_deg: f64,
+        /// Closest camera distance (world units).
+        #[arg(long, default_value_t = 0.15, value_parser = distance)]
+        from: f64,
+        /// Farthest camera distance (world units).
+        #[arg(long, default_value_t = 400.0, value_parser = distance)]
+        to: f64,
+        /// Frames along the dolly (2 to 10000).
+        #[arg(long, default_value_t = 120, value_parser = clap::value_parser!(u32).range(2..=10000))]
+        frames: u32,
+        /// Image size, WxH.
+        #[arg(long, default_value = "160x120", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Write the engine bundle: the pre-convolved tables (EXR), a manifest (JSON), and self-contained
     /// WGSL and GLSL snippets that evaluate the filtered material from them.
     Export {

@@ -18,6 +18,7 @@ mod chart;
 mod cielab;
 mod cli;
 mod diagnose;
+mod dolly;
 mod editor;
 mod eval;
 mod inspect;
@@ -267,6 +268,30 @@ fn run(cli: Cli) -> Result<()> {
                 frames,
             };
             render_cmd::bench(&sweep, &cfg, json)?
+        }
+        Some(Command::Dolly {
+            view_deg,
+            from,
+            to,
+            frames,
+            size,
+            json,
+        }) => {
+            let opts = dolly::Options {
+                view_deg,
+                range: (from, to),
+                frames,
+                size,
+            };
+            let (adapter, rows) = dolly::run(&preset, &opts)?;
+            if json {
+                outln!(
+                    "{}",
+                    serde_json::to_string_pretty(&dolly::to_json(&rows, &opts, &adapter))?
+                );
+            } else {
+                out!("{}", dolly::table(&rows, &opts, &adapter));
+            }
         }
         Some(Command::Export { out }) => {
             let written = preset_io::export_bundle(&preset, cli.preset.as_deref(), &out)?;

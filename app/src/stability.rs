@@ -15,7 +15,6 @@ use crate::stability_cases::{Path, Row, SpecialFunction};
 use crate::stability_materials::{self as stability, material_cases};
 use anyhow::Result;
 use glam::DVec2;
-use lodestone_core::driver::footprint::Footprint;
 use lodestone_core::eval::{Evaluator, Method};
 use lodestone_core::scene::camera::Camera;
 use lodestone_core::scene::direction::direction;
@@ -130,12 +129,10 @@ fn wgsl_material_rows(r: &Renderer) -> Vec<Row> {
                                 continue;
                             }
                             let c = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-                            let Some((_, cov)) = camera.plane_footprint(c, w, h) else {
+                            if camera.plane_footprint(c, w, h).is_none() {
                                 continue;
-                            };
-                            let ray = camera.ray(c, w, h);
-                            let want =
-                                p.pixel(method, ray.origin, ray.dir, light, Footprint { cov });
+                            }
+                            let want = p.plane_pixel(method, &camera, c, (w, h), light);
                             compared += 1;
                             if (0..3).any(|k| {
                                 (f64::from(got[k]) - want[k]).abs() > 5e-3 * want[k].abs() + 2e-4

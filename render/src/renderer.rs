@@ -27,6 +27,7 @@ use lodestone_core::scene::bound_grid::BoundGrid;
 use lodestone_core::scene::camera::{Camera, PIXEL_SIGMA};
 use lodestone_core::scene::march::March;
 use lodestone_core::scene::shape::Shape;
+use lodestone_core::scene::surface::Surface;
 use std::collections::HashMap;
 use std::f64::consts::TAU;
 use std::sync::{Arc, Mutex, OnceLock};
@@ -169,6 +170,9 @@ pub struct GpuMaterial {
     all_features: bool,
     /// Bytes per part of the data buffer.
     segments: Vec<(&'static str, usize)>,
+    /// The explicit surface without its bound grid, to keep the eye above it
+    /// ([`Surface::clear_camera`]).
+    surface: Surface,
 }
 
 /// One view's render target: an accumulation buffer (linear RGB + sample count per pixel) and its
@@ -788,6 +792,10 @@ impl GpuMaterial {
             features,
             all_features,
             segments,
+            surface: Surface {
+                grid: None,
+                ..prepared.surface.clone()
+            },
         })
     }
 
@@ -920,9 +928,17 @@ impl Renderer {
             .get(&self.ctx.device, material.pipeline_features(scene))
             .pipeline;
         let mut params = ViewParams::default();
+        // Views of the plane keep the eye clear of the relief, as core's `plane_pixel` does.
+        let lifted = match scene.shape {
+            Shape::Plane => material.surface.clear_camera(&scene.camera),
+            Shape::Cylinder { .. } => scene.camera,
+        };
         let cam = Camera {
-            target: [0.0, 0.0],
-            ..scene.camera
+            target: [
+                lifted.target[0] - scene.camera.target[0],
+                lifted.target[1] - scene.camera.target[1],
+            ],
+            ..lifted
         };
         let (r, u, f) = cam.basis();
         let v3 = |v: DVec3| [v.x as f32, v.y as f32, v.z as f32];

@@ -61,8 +61,9 @@ impl Evaluator {
     }
 
     /// One pixel of an analytic view of the plane: pixel centre `p` of a `width × height` image of
-    /// `camera`, its footprint on the mean plane, then [`Evaluator::pixel`] (0 for sky pixels). The
-    /// plane's counterpart of [`Evaluator::cylinder_pixel`].
+    /// `camera` (lifted clear of the relief: [`crate::scene::surface::Surface::clear_camera`]), its footprint on the
+    /// mean plane, then [`Evaluator::pixel`] (0 for sky pixels). The plane's counterpart of
+    /// [`Evaluator::cylinder_pixel`].
     pub fn plane_pixel(
         &self,
         method: Method,
@@ -71,6 +72,7 @@ impl Evaluator {
         (width, height): (u32, u32),
         wi: DVec3,
     ) -> [f64; 3] {
+        let camera = self.surface.clear_camera(camera);
         let Some((_, cov)) = camera.plane_footprint(p, width, height) else {
             return [0.0; 3];
         };

@@ -72,6 +72,29 @@ impl Camera {
         DVec3::new(self.target[0], self.target[1], 0.0) + self.to_eye() * self.distance.max(1e-9)
     }
 
+    /// This camera moved straight up where needed so that its eye is at least `clearance` above
+    /// the mean plane ([`crate::scene::surface::Surface::clear_camera`] keeps it above the relief).
+    ///
+    /// Elevation, azimuth, field of view and so the view direction are unchanged; the target
+    /// slides along the view so it stays on z = 0 (it moves away: the new distance is
+    /// `clearance / cos θ`). The identity when the eye is already clear or `clearance` is not a
+    /// positive finite number. Continuous in the distance and the clearance: no jump where the
+    /// lift starts.
+    pub fn clear_of(&self, clearance: f64) -> Camera {
+        let to_eye = self.to_eye();
+        let eye = self.eye();
+        if !(clearance.is_finite() && clearance > 0.0 && eye.z < clearance && to_eye.z > 0.0) {
+            return *self;
+        }
+        let distance = clearance / to_eye.z;
+        let target = DVec3::new(eye.x, eye.y, clearance) - to_eye * distance;
+        Camera {
+            distance,
+            target: [target.x, target.y],
+            ..*self
+        }
+    }
+
     /// Right, up and forward unit vectors (right-handed; up has a positive z component).
     pub fn basis(&self) -> (DVec3, DVec3, DVec3) {
         let f = -self.to_eye();
@@ -194,6 +217,42 @@ mod tests {
             let q = r.origin + r.dir * (-r.origin.z / r.dir.z);
             assert!((DVec2::new(q.x, q.y) - x0).length() < 1e-9);
         }
+    }
+
+    /// The lifted eye is exactly at the clearance, straight above the old eye, looking the same
+    /// way; an eye already clear, or a clearance that is not a positive number, changes nothing;
+    /// the lift is continuous where it starts.
+    #[test]
+    fn a_camera_below_the_clearance_is_lifted_straight_up() {
+        let c = Camera {
+            elevation_deg: 77.0,
+            azimuth_deg: 40.0,
+            distance: 0.15,
+            target: [0.3, -0.2],
+            fov_deg: 35.0,
+        };
+        let lifted = c.clear_of(0.1);
+        let (e, l) = (c.eye(), lifted.eye());
+        assert!(e.z < 0.1);
+        assert!((l.z - 0.1).abs() < 1e-12, "{l}");
+        assert!((l.x - e.x).abs() < 1e-12 && (l.y - e.y).abs() < 1e-12);
+        let (_, _, f) = c.basis();
+        let (_, _, g) = lifted.basis();
+        assert!((f - g).length() < 1e-12);
+        assert_eq!(c.clear_of(0.01), c);
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert_eq!(c.clear_of(bad), c);
+        }
+        // Continuity: at the distance where the eye reaches the clearance, lifted = unlifted.
+        let at = Camera {
+            distance: 0.1 / c.to_eye().z,
+            ..c
+        };
+        let just_below = Camera {
+            distance: at.distance * (1.0 - 1e-9),
+            ..c
+        };
+        assert!((just_below.clear_of(0.1).eye() - at.eye()).length() < 1e-9);
     }
 
     #[test]
