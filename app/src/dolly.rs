@@ -11,6 +11,8 @@
 use crate::preset_io::Resolved;
 use crate::render_cmd::{View, renderer};
 use anyhow::Result;
+use glam::DVec2;
+use lodestone_core::eval::Method;
 use lodestone_core::scene::march::March;
 use lodestone_core::scene::shape::Shape;
 use lodestone_render::{GpuMaterial, LinearImage, ViewMode, ViewTarget};
@@ -60,6 +62,20 @@ pub struct Excess {
     pub differing_pixels: Vec<usize>,
 }
 
+/// Where the two marches' images differ by more than [`VISIBLE`]: which one core's f64 pixel
+/// ([`lodestone_core::eval::Evaluator::plane_pixel`], the definition of the view) agrees with.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Arbiter {
+    /// Pixels where the fast march is the nearer to core.
+    pub fast_nearer: usize,
+    /// Pixels where the reference march is the nearer.
+    pub reference_nearer: usize,
+    /// Largest difference between the fast march's pixel and core's among them.
+    pub fast_off: f32,
+    /// The same for the reference march.
+    pub reference_off: f32,
+}
+
 /// One mode's figure.
 #[derive(Clone, Debug)]
 pub struct Row {
@@ -71,13 +87,19 @@ pub struct Row {
     pub reference: Jumps,
     /// Fast against reference.
     pub excess: Excess,
+    /// Who is right where they differ.
+    pub arbiter: Arbiter,
 }
 
 /// The modes a dolly renders (the analytic views: the ones with a level of detail).
-const MODES: [(&str, ViewMode); 3] = [
-    ("naive", ViewMode::Naive),
-    ("view_independent", ViewMode::ViewIndependent),
-    ("filtered", ViewMode::Filtered),
+const MODES: [(&str, ViewMode, Method); 3] = [
+    ("naive", ViewMode::Naive, Method::Naive),
+    (
+        "view_independent",
+        ViewMode::ViewIndependent,
+        Method::ViewIndependent,
+    ),
+    ("filtered", ViewMode::Filtered, Method::Filtered),
 ];
 
 /// The distance of frame `i` of `n`, geometric from `range.0` to `range.1`.
@@ -176,7 +198,7 @@ pub fn run(preset: &Resolved, opts: &Options) -> Result<(String, Vec<Row>)> {
     let gpu_fast = GpuMaterial::new(r.context(), &fast, target_point)?;
     let gpu_reference = GpuMaterial::new(r.context(), &reference, target_point)?;
     let mut rows = vec![];
-    for (name, mode) in MODES {
+    for (name, mode, method) in MODES {
         let mut frames = |g: &GpuMaterial| -> Result<Vec<LinearImage>> {
             (0..opts.frames)
                 .map(|i| {
@@ -189,11 +211,38 @@ pub fn run(preset: &Resolved, opts: &Options) -> Result<(String, Vec<Row>)> {
         };
         let (images_fast, images_reference) = (frames(&gpu_fast)?, frames(&gpu_reference)?);
         let (jf, jr) = (jumps(&images_fast), jumps(&images_reference));
+        let mut arbiter = Arbiter::default();
+        for (i, (a, b)) in images_fast.iter().zip(&images_reference).enumerate() {
+            let scene = view(distance(opts.range, i as u32, opts.frames)).scene();
+            for k in 0..a.pixels.len() {
+                if pixel_difference(a, b, k) <= VISIBLE {
+                    continue;
+                }
+                let (x, y) = (k as u32 % w, k as u32 / w);
+                let p = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+                let core = fast.plane_pixel(method, &scene.camera, p, (w, h), scene.light);
+                let off = |img: &LinearImage| {
+                    let got = img.rgb(x, y);
+                    (0..3)
+                        .map(|c| (f64::from(got[c]) - core[c]).abs() as f32)
+                        .fold(0.0, f32::max)
+                };
+                let (of, or) = (off(a), off(b));
+                if of <= or {
+                    arbiter.fast_nearer += 1;
+                } else {
+                    arbiter.reference_nearer += 1;
+                }
+                arbiter.fast_off = arbiter.fast_off.max(of);
+                arbiter.reference_off = arbiter.reference_off.max(or);
+            }
+        }
         rows.push(Row {
             mode: name,
             fast: summarise(&jf),
             reference: summarise(&jr),
             excess: excess(&jf, &jr, (&images_fast, &images_reference)),
+            arbiter,
         });
     }
     Ok((r.context().describe(), rows))
@@ -218,6 +267,12 @@ pub fn to_json(rows: &[Row], opts: &Options, adapter: &str) -> serde_json::Value
             "excess_over_visible": r.excess.count,
             "max_image_difference": r.excess.max_image_difference,
             "differing_pixels_per_frame": r.excess.differing_pixels,
+            "where_they_differ": {
+                "fast_nearer_core": r.arbiter.fast_nearer,
+                "reference_nearer_core": r.arbiter.reference_nearer,
+                "fast_max_off_core": r.arbiter.fast_off,
+                "reference_max_off_core": r.arbiter.reference_off,
+            },
         })).collect::<Vec<_>>(),
     })
 }
@@ -230,7 +285,9 @@ pub fn table(rows: &[Row], opts: &Options, adapter: &str) -> String {
         s,
         "{adapter}, {}×{}, view {}°, {} frames from distance {} to {} (×{:.4} per frame); jump = the \
          largest channel's |change| between consecutive frames (linear RGB); excess = a pixel's jump \
-         under the fast march minus its jump under the reference march; visible > {VISIBLE}",
+         under the fast march minus its jump under the reference march; visible > {VISIBLE}; where \
+         the marches' images differ visibly, how many pixels core's f64 pixel is nearer the fast / the \
+         reference march",
         opts.size.0,
         opts.size.1,
         opts.view_deg,
@@ -241,7 +298,7 @@ pub fn table(rows: &[Row], opts: &Options, adapter: &str) -> String {
     );
     let _ = writeln!(
         s,
-        "{:<17} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>10} {:>8} {:>10}",
+        "{:<17} {:>9} {:>9} {:>9} {:>9} {:>9} {:>9} {:>10} {:>8} {:>10} {:>13}",
         "mode",
         "fast max",
         "fast p999",
@@ -251,12 +308,13 @@ pub fn table(rows: &[Row], opts: &Options, adapter: &str) -> String {
         "ref >vis",
         "excess max",
         "#excess",
-        "max |f−r|"
+        "max |f−r|",
+        "core: f / r"
     );
     for r in rows {
         let _ = writeln!(
             s,
-            "{:<17} {:>9.5} {:>9.5} {:>9.5} {:>9.5} {:>9.5} {:>9.5} {:>10.5} {:>8} {:>10.5}",
+            "{:<17} {:>9.5} {:>9.5} {:>9.5} {:>9.5} {:>9.5} {:>9.5} {:>10.5} {:>8} {:>10.5} {:>13}",
             r.mode,
             r.fast.max,
             r.fast.p999,
@@ -266,7 +324,8 @@ pub fn table(rows: &[Row], opts: &Options, adapter: &str) -> String {
             r.reference.over,
             r.excess.max,
             r.excess.count,
-            r.excess.max_image_difference
+            r.excess.max_image_difference,
+            format!("{} / {}", r.arbiter.fast_nearer, r.arbiter.reference_nearer)
         );
     }
     s
