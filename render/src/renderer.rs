@@ -928,10 +928,12 @@ impl Renderer {
             .get(&self.ctx.device, material.pipeline_features(scene))
             .pipeline;
         let mut params = ViewParams::default();
-        // Views of the plane keep the eye clear of the relief, as core's `plane_pixel` does.
+        // The eye is kept clear of the relief, as core's `plane_pixel` and `cylinder_pixel` do.
         let lifted = match scene.shape {
             Shape::Plane => material.surface.clear_camera(&scene.camera),
-            Shape::Cylinder { .. } => scene.camera,
+            Shape::Cylinder { radius } => material
+                .surface
+                .clear_cylinder_camera(&scene.camera, radius),
         };
         let cam = Camera {
             target: [

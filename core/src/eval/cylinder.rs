@@ -62,8 +62,10 @@ impl Evaluator {
         self.shade_hit(f, n, wo_l, wi_l, &m, sees)
     }
 
-    /// One pixel of an analytic view of the cylinder: the ray meets the mean cylinder; the plane
-    /// model runs in the tangent plane there with the pixel's footprint on that plane.
+    /// One pixel of an analytic view of the cylinder (the camera lifted clear of the relief:
+    /// [`crate::scene::surface::Surface::clear_cylinder_camera`]): the ray meets the mean
+    /// cylinder; the plane model runs in the tangent plane there with the pixel's footprint on
+    /// that plane.
     pub fn cylinder_pixel(
         &self,
         method: Method,
@@ -73,6 +75,7 @@ impl Evaluator {
         (width, height): (u32, u32),
         wi: DVec3,
     ) -> [f64; 3] {
+        let camera = &self.surface.clear_cylinder_camera(camera, r);
         let ray = camera.ray(p, width, height);
         let Some((t, _)) = intersect(r, r, ray.origin, ray.dir) else {
             return [0.0; 3];

@@ -113,6 +113,25 @@ impl Surface {
         camera.clear_of(self.height(DVec2::new(e.x, e.y)) + EYE_MARGIN * self.h_max)
     }
 
+    /// [`Surface::clear_camera`] for the cylinder of radius `r` ([`crate::scene::cylinder`]): the
+    /// eye lifted straight up until its distance from the axis is `EYE_MARGIN · h_max` more than
+    /// the displaced radius `r + h(u, v)` at its own surface coordinates. Lifting moves `v`, so the
+    /// height is looked up again, three times at most (each step continuous in the camera). An eye
+    /// beside the cylinder (|y| beyond the radius it needs) is left as it is: it is outside.
+    pub fn clear_cylinder_camera(&self, camera: &Camera, r: f64) -> Camera {
+        let mut c = *camera;
+        for _ in 0..3 {
+            let e = c.eye();
+            let (u, v, rho, _) = crate::scene::cylinder::to_surface(r, e);
+            let need = r + self.height(DVec2::new(u, v)) + EYE_MARGIN * self.h_max;
+            if !(rho < need && need > e.y.abs()) {
+                break;
+            }
+            c = c.clear_of((need * need - e.y * e.y).sqrt() - r);
+        }
+        c
+    }
+
     /// h(x).
     pub fn height(&self, x: DVec2) -> f64 {
         self.height_of(self.driver.value(x))
@@ -280,6 +299,45 @@ mod tests {
             ..Camera::default()
         };
         assert_eq!(s.clear_camera(&high), high);
+    }
+
+    /// The cylinder's eye ends outside the displaced cylinder (within the fixed point's last
+    /// step), looking the same way; an eye far away is unchanged.
+    #[test]
+    fn a_camera_inside_the_cylinders_relief_is_lifted_out() {
+        let s = surface();
+        let r = 2.0;
+        let mut lifted_some = 0;
+        for i in 0..64 {
+            let c = Camera {
+                elevation_deg: 50.0 + 0.6 * f64::from(i),
+                azimuth_deg: 23.0 * f64::from(i),
+                distance: 0.01 + 0.02 * f64::from(i % 8),
+                target: [0.13 * f64::from(i), 0.0],
+                fov_deg: 35.0,
+            };
+            let l = s.clear_cylinder_camera(&c, r);
+            let e = l.eye();
+            let (u, v, rho, _) = crate::scene::cylinder::to_surface(r, e);
+            let ground = r + s.height(DVec2::new(u, v));
+            assert!(
+                rho > ground + 0.5 * EYE_MARGIN * s.h_max,
+                "{i}: ρ {rho} over {ground}"
+            );
+            if l != c {
+                lifted_some += 1;
+                assert!((l.basis().2 - c.basis().2).length() < 1e-12);
+            }
+        }
+        assert!(
+            lifted_some > 16,
+            "the cases must include eyes inside the relief"
+        );
+        let high = Camera {
+            distance: 50.0,
+            ..Camera::default()
+        };
+        assert_eq!(s.clear_cylinder_camera(&high, r), high);
     }
 
     #[test]
