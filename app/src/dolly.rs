@@ -14,7 +14,6 @@ use anyhow::Result;
 use glam::DVec2;
 use lodestone_core::eval::Method;
 use lodestone_core::scene::march::March;
-use lodestone_core::scene::shape::Shape;
 use lodestone_render::{GpuMaterial, LinearImage, ViewMode, ViewTarget};
 
 /// What `lodestone dolly` sweeps.
@@ -185,15 +184,7 @@ pub fn run(preset: &Resolved, opts: &Options) -> Result<(String, Vec<Row>)> {
     let fast = preset.prepare()?;
     let mut reference = fast.clone();
     reference.surface.march = March::Reference;
-    let view = |distance| View {
-        view_deg: opts.view_deg,
-        view_azimuth_deg: 0.0,
-        light_deg: 30.0,
-        light_azimuth_deg: 90.0,
-        distance,
-        shape: Shape::Plane,
-        march: March::Fast,
-    };
+    let view = |distance| View::measurement(opts.view_deg, distance);
     let target_point = view(1.0).scene().camera.target;
     let gpu_fast = GpuMaterial::new(r.context(), &fast, target_point)?;
     let gpu_reference = GpuMaterial::new(r.context(), &reference, target_point)?;

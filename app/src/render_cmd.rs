@@ -34,6 +34,20 @@ pub struct View {
 }
 
 impl View {
+    /// The measurement view of `bench` and `dolly`: the plane seen from `view_deg` at azimuth 0 and
+    /// `distance`, light 30° from the normal at azimuth 90°, the fast march.
+    pub fn measurement(view_deg: f64, distance: f64) -> Self {
+        Self {
+            view_deg,
+            view_azimuth_deg: 0.0,
+            light_deg: 30.0,
+            light_azimuth_deg: 90.0,
+            distance,
+            shape: Shape::Plane,
+            march: March::Fast,
+        }
+    }
+
     /// The scene: camera on the plane's origin, light from the given angles.
     pub fn scene(&self) -> Scene {
         let camera = Camera {
@@ -279,16 +293,7 @@ pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Re
         let flat = flat_material.prepare()?;
         for &distance in &cfg.distance {
             for &view_deg in &cfg.view_deg {
-                let scene = View {
-                    view_deg,
-                    view_azimuth_deg: 0.0,
-                    light_deg: 30.0,
-                    light_azimuth_deg: 90.0,
-                    distance,
-                    shape: Shape::Plane,
-                    march: March::Fast,
-                }
-                .scene();
+                let scene = View::measurement(view_deg, distance).scene();
                 let gm = GpuMaterial::new(r.context(), &prepared, scene.camera.target)?;
                 let gref = GpuMaterial::new(r.context(), &reference, scene.camera.target)?;
                 let gflat = GpuMaterial::new(r.context(), &flat, scene.camera.target)?;
