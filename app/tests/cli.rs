@@ -73,6 +73,23 @@ fn run_measured(args: &[&str], limit: std::time::Duration) -> Measured {
     }
 }
 
+/// The JSON a GPU command prints, or `None` (after saying the test is skipped) without an
+/// adapter; any other failure fails the test with the command's output.
+fn gpu_json(args: &[&str], what: &str) -> Option<serde_json::Value> {
+    let out = lodestone(args);
+    if out.status.code() == Some(3) {
+        lodestone_tests::skip(what, "no adapter");
+        return None;
+    }
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}\n{text}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    Some(serde_json::from_str(&text).expect("JSON"))
+}
+
 /// Hostile input is refused at once, before any work: exit code 2 within 10 s and under 1 GiB of
 /// memory, with `says` in the message.
 fn assert_refused(args: &[&str], says: &str) {
@@ -496,31 +513,25 @@ fn environment_file_matches_the_procedural_sky_and_a_missing_one_exits_2() {
 fn bench_sweeps_presets_distances_and_views_against_the_flat_reference() {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../presets/");
     let presets = format!("{dir}default.ron,{dir}moss.ron");
-    let out = lodestone(&[
-        "bench",
-        "--json",
-        "--size",
-        "16x12",
-        "--frames",
-        "1",
-        "--distance",
-        "1.5,40",
-        "--view-deg",
-        "60",
-        "--presets",
-        &presets,
-    ]);
-    if out.status.code() == Some(3) {
-        lodestone_tests::skip("the bench", "no adapter");
+    let Some(v) = gpu_json(
+        &[
+            "bench",
+            "--json",
+            "--size",
+            "16x12",
+            "--frames",
+            "1",
+            "--distance",
+            "1.5,40",
+            "--view-deg",
+            "60",
+            "--presets",
+            &presets,
+        ],
+        "the bench",
+    ) else {
         return;
-    }
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}\n{text}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+    };
     let rows = v["rows"].as_array().expect("rows");
     assert_eq!(rows.len(), 4, "2 presets × 2 distances × 1 view");
     let positive = |x: &serde_json::Value| x.as_f64().is_some_and(|x| x.is_finite() && x > 0.0);
@@ -562,20 +573,14 @@ fn bench_sweeps_presets_distances_and_views_against_the_flat_reference() {
 /// relief, the first two frames differed on most pixels: the eye was inside the material).
 #[test]
 fn the_dolly_shows_no_popping_of_the_fast_march() {
-    let out = lodestone(&[
-        "dolly", "--json", "--size", "24x16", "--frames", "10", "--from", "0.15", "--to", "400",
-    ]);
-    if out.status.code() == Some(3) {
-        lodestone_tests::skip("the dolly", "no adapter");
+    let Some(v) = gpu_json(
+        &[
+            "dolly", "--json", "--size", "24x16", "--frames", "10", "--from", "0.15", "--to", "400",
+        ],
+        "the dolly",
+    ) else {
         return;
-    }
-    let text = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{}\n{text}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+    };
     let rows = v["rows"].as_array().expect("rows");
     assert_eq!(rows.len(), 3, "naive, view-independent, filtered");
     for row in rows {
