@@ -6,7 +6,7 @@
 //! `--time` the pipeline compile times and frame times of both on the adapter.
 
 use crate::preset_io::Resolved;
-use crate::render_cmd::{View, frame_ms, renderer};
+use crate::render_cmd::{View, frame_ms_interleaved, renderer};
 use anyhow::Result;
 use lodestone_core::material::features::FeatureSet;
 use lodestone_render::renderer::material_data_for;
@@ -88,11 +88,15 @@ pub fn inspect(preset: &Resolved, opts: Options) -> Result<Inspection> {
             ("filtered", ViewMode::Filtered),
             ("truth (1 ray/pixel)", ViewMode::Truth),
         ] {
-            let a = frame_ms(&r, &mut t, &special, &scene, mode, opts.frames);
+            let ms = frame_ms_interleaved(
+                &r,
+                &mut t,
+                &[(&special, mode), (&all, mode)],
+                &scene,
+                opts.frames,
+            );
             t.reset();
-            let b = frame_ms(&r, &mut t, &all, &scene, mode, opts.frames);
-            t.reset();
-            frames.push((name, a, b));
+            frames.push((name, ms[0], ms[1]));
         }
         Some(Timings {
             adapter: r.context().describe(),

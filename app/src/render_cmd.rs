@@ -202,31 +202,39 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-/// Median frame time of `mode` in milliseconds, after one warm-up frame (which also compiles the
-/// pipeline). Throughput: batches of 8 frames submitted back to back, one wait per batch; the
-/// median over `frames` batches of the mean frame time (single-frame submit/wait latency would
-/// dominate on a fast GPU otherwise).
-pub fn frame_ms(
+/// Median frame times in milliseconds of several (material, mode) cases, after one warm-up frame
+/// each (which also compiles the pipeline). Throughput: batches of 8 frames submitted back to
+/// back, one wait per batch; the median over `frames` batches of the mean frame time (single-frame
+/// submit/wait latency would dominate on a fast GPU otherwise). The batches are interleaved round by round
+/// (case 1, case 2, …, case 1, …): a machine that slows down or speeds up during the run shifts
+/// every case alike, so the ratios between them hold (on the shared 2-core machine, timing the
+/// cases one after the other moved a ratio by 40% between runs).
+pub fn frame_ms_interleaved(
     r: &Renderer,
     target: &mut ViewTarget,
-    gm: &GpuMaterial,
+    cases: &[(&GpuMaterial, ViewMode)],
     scene: &Scene,
-    mode: ViewMode,
     frames: u32,
-) -> f64 {
+) -> Vec<f64> {
     const BATCH: u32 = 8;
-    r.draw(target, gm, scene, mode, 1);
-    r.wait();
-    let mut times = vec![];
-    for _ in 0..frames.max(1) {
-        let t = Instant::now();
-        for _ in 0..BATCH {
-            r.draw(target, gm, scene, mode, 1);
-        }
+    for (gm, mode) in cases {
+        target.reset();
+        r.draw(target, gm, scene, *mode, 1);
         r.wait();
-        times.push(t.elapsed().as_secs_f64() * 1e3 / f64::from(BATCH));
     }
-    median(times)
+    let mut times = vec![vec![]; cases.len()];
+    for _ in 0..frames.max(1) {
+        for ((gm, mode), case_times) in cases.iter().zip(&mut times) {
+            target.reset();
+            let t = Instant::now();
+            for _ in 0..BATCH {
+                r.draw(target, gm, scene, *mode, 1);
+            }
+            r.wait();
+            case_times.push(t.elapsed().as_secs_f64() * 1e3 / f64::from(BATCH));
+        }
+    }
+    times.into_iter().map(median).collect()
 }
 
 /// What `lodestone bench` sweeps.
@@ -297,20 +305,23 @@ pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Re
                 let gm = GpuMaterial::new(r.context(), &prepared, scene.camera.target)?;
                 let gref = GpuMaterial::new(r.context(), &reference, scene.camera.target)?;
                 let gflat = GpuMaterial::new(r.context(), &flat, scene.camera.target)?;
-                let flat_ms =
-                    frame_ms(&r, &mut target, &gflat, &scene, ViewMode::Naive, cfg.frames);
-                let mut time = |g: &GpuMaterial| {
+                // Every case's batches interleaved: flat, then each mode with the fast and the
+                // reference march.
+                let mut cases = vec![(&gflat, ViewMode::Naive)];
+                for g in [&gm, &gref] {
+                    cases.extend(BENCH_MODES.iter().map(|(_, mode)| (g, *mode)));
+                }
+                let ms = frame_ms_interleaved(&r, &mut target, &cases, &scene, cfg.frames);
+                let flat_ms = ms[0];
+                let named = |part: &[f64]| {
                     BENCH_MODES
                         .iter()
-                        .map(|(n, mode)| {
-                            target.reset();
-                            let ms = frame_ms(&r, &mut target, g, &scene, *mode, cfg.frames);
-                            ((*n).to_owned(), ms)
-                        })
+                        .zip(part)
+                        .map(|((n, _), t)| ((*n).to_owned(), *t))
                         .collect()
                 };
-                let frame_ms = time(&gm);
-                let reference_ms = time(&gref);
+                let frame_ms = named(&ms[1..=BENCH_MODES.len()]);
+                let reference_ms = named(&ms[1 + BENCH_MODES.len()..]);
                 rows.push(BenchRow {
                     preset: name.clone(),
                     view_deg,
@@ -329,7 +340,7 @@ pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Re
             "adapter": adapter,
             "size": [w, h],
             "frames": cfg.frames,
-            "timing": "synchronised wall time per frame: median over batches of 8 back-to-back frames",
+            "timing": "synchronised wall time per frame: median over batches of 8 back-to-back frames, the cases of a row interleaved batch by batch",
             "flat": "the same camera and colour table with sigma_h = 0 (a textured plane), naive mode",
             "rows": rows.iter().map(|row| serde_json::json!({
                 "preset": row.preset,
@@ -347,7 +358,7 @@ pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Re
         outln!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         outln!(
-            "{adapter}, {w}×{h}, median over {} batches of 8 frames (synchronised wall time); \
+            "{adapter}, {w}×{h}, median over {} batches of 8 frames (synchronised wall time, all cases of a row interleaved batch by batch); \
              ×flat = frame time over the same view with σ_h = 0; /ref = fast march over the reference march",
             cfg.frames
         );
