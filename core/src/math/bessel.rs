@@ -85,6 +85,29 @@ pub fn bessel_ratio_derivative(x: f64) -> f64 {
     (1.0 - r_over_x - r * r).clamp(1e-12, 0.5)
 }
 
+/// `(ln I0(x), A(x), A′(x))` in one evaluation of the polynomials: what the saddlepoint's Newton
+/// iteration needs per wave ([`crate::microfacet::slope_density`]); equal to [`log_bessel_i0`],
+/// [`bessel_ratio`] and [`bessel_ratio_derivative`] to rounding (the same operations, shared).
+pub fn bessel_terms(x: f64) -> [f64; 3] {
+    let a = x.abs();
+    let (ln_i0, r, r_over_x) = if a <= 3.75 {
+        let t = a / 3.75;
+        let i0 = i0_small(t * t);
+        let q = i1_over_x_small(t * t) / i0;
+        (i0.ln(), a * q, q)
+    } else {
+        let t = 3.75 / a;
+        let i0 = i0_large(t);
+        let r = i1_large(t) / i0;
+        (a - 0.5 * a.ln() + i0.ln(), r, r / a)
+    };
+    [
+        ln_i0,
+        r.copysign(x),
+        (1.0 - r_over_x - r * r).clamp(1e-12, 0.5),
+    ]
+}
+
 /// `(A′, A″, A‴)` of `A = I1/I0`: the variance, third and fourth cumulants of sin ψ under the
 /// weight e^{x sin ψ} (the derivatives of `ln I0`). From `A′ = 1 − A/x − A²` differentiated, with
 /// the Taylor series `A′ = ½ − 3x²/16`, `A″ = −3x/8 + 5x³/24`, `A‴ = −3/8 + 5x²/8` below
@@ -146,6 +169,21 @@ mod tests {
             );
         }
         assert!(log_bessel_i0(1e300).is_finite() && bessel_ratio(-1e300) < -0.99);
+        // The fused form is the three functions (to rounding: A is a·(I1/x)/I0 there).
+        for x in [0.0, -1e-6, 0.3, 3.75, -3.76, 9.0, 1e300, -1e300] {
+            let want = [
+                log_bessel_i0(x),
+                bessel_ratio(x),
+                bessel_ratio_derivative(x),
+            ];
+            let got = bessel_terms(x);
+            for k in 0..3 {
+                assert!(
+                    (got[k] - want[k]).abs() <= 1e-15 * (1.0 + want[k].abs()),
+                    "x = {x}: {got:?} vs {want:?}"
+                );
+            }
+        }
         // A″ and A‴ by differences of A′ and A″, on both sides of the series switch.
         for x in [0.05, 0.29, 0.31, 0.8, 2.0, 5.0, -1.5, 12.0] {
             let h = 1e-4;

@@ -23,16 +23,6 @@ fn i1_large(t: f32) -> f32 {
     return 0.39894228 + t * (-0.03988024 + t * (-0.00362018 + t * (0.00163801 + t * (-0.01031555 + t * (0.02282967 + t * (-0.02895312 + t * (0.01787654 - t * 0.00420059)))))));
 }
 
-// ln I0(x).
-fn log_bessel_i0(x: f32) -> f32 {
-    let a = abs(x);
-    if (a <= 3.75) {
-        let t = a / 3.75;
-        return log(i0_small(t * t));
-    }
-    return a - 0.5 * log(a) + log(i0_large(3.75 / a));
-}
-
 // A(x) = I1(x)/I0(x).
 fn bessel_ratio(x: f32) -> f32 {
     let a = abs(x);
@@ -62,6 +52,28 @@ fn bessel_ratio_derivative(x: f32) -> f32 {
         q = r / a;
     }
     return clamp(1.0 - q - r * r, 1e-12, 0.5);
+}
+
+// (ln I0(x), A(x), A′(x)) in one evaluation of the polynomials.
+fn bessel_terms(x: f32) -> vec3<f32> {
+    let a = abs(x);
+    var ln_i0: f32;
+    var r: f32;
+    var q: f32;
+    if (a <= 3.75) {
+        let t = a / 3.75;
+        let i0 = i0_small(t * t);
+        q = i1_over_x_small(t * t) / i0;
+        r = a * q;
+        ln_i0 = log(i0);
+    } else {
+        let t = 3.75 / a;
+        let i0 = i0_large(t);
+        r = i1_large(t) / i0;
+        q = r / a;
+        ln_i0 = a - 0.5 * log(a) + log(i0);
+    }
+    return vec3<f32>(ln_i0, select(r, -r, x < 0.0), clamp(1.0 - q - r * r, 1e-12, 0.5));
 }
 
 // (A′, A″, A‴), the series below |x| = 0.3.
