@@ -1,0 +1,117 @@
+//! #17's accuracy grid in test-sized form: every preset of the library, far patch, views 0°, 60°
+//! and 85° × the light at the normal and 30° on the view's side and opposite; the filtered model
+//! against the ray-traced ground truth (20 000 seeded rays: deterministic).
+//!
+//! The error that counts is what lies beyond the truth's own noise, `(|F − T| − 3·s.e.)⁺ / T`,
+//! worst channel. The goal of #17 is ≤ 1% up to 60° and ≤ 4% at 85°. Where a preset does not meet
+//! it yet, [`KNOWN`] holds its measured excess (rounded up by about a tenth): the test fails when a
+//! configuration that met the goal stops meeting it, and when a known shortfall grows. Shrink or
+//! remove a `KNOWN` entry when a change improves it (the test prints every configuration).
+
+use lodestone_core::eval::FootprintQuery;
+use lodestone_core::material::Material;
+use lodestone_core::scene::direction::direction;
+use lodestone_tests::{prepare, presets};
+
+/// Ground-truth rays per configuration.
+const RAYS: usize = 20_000;
+
+/// Views from the normal (degrees).
+const VIEWS: [f64; 3] = [0.0, 60.0, 85.0];
+
+/// Lights: (angle from the normal, azimuth; the view's azimuth is 0), degrees.
+const LIGHTS: [(f64, f64); 3] = [(0.0, 0.0), (30.0, 0.0), (30.0, 180.0)];
+
+/// Open shortfalls of #17: (preset file, view, light angle, light azimuth, largest excess allowed),
+/// measured 2026-12-02 (the excess ×1.1). Cobblestones: the image's colour is correlated with its
+/// slopes and with grazing visibility (mortar at the stones' steep edges), which filtering with
+/// heights independent of slopes cannot say (docs/design.md). Snow under sky: the environment's
+/// share at 85°. Terraces: the transfer mixture's 8 bins against its 241-node reference (1.7% at
+/// 0°, docs/design.md).
+const KNOWN: &[(&str, f64, f64, f64, f64)] = &[
+    ("cobblestones.ron", 0.0, 0.0, 0.0, 0.0145),
+    ("cobblestones.ron", 60.0, 30.0, 180.0, 0.016),
+    ("cobblestones.ron", 85.0, 0.0, 0.0, 0.162),
+    ("cobblestones.ron", 85.0, 30.0, 0.0, 0.079),
+    ("cobblestones.ron", 85.0, 30.0, 180.0, 0.18),
+    ("snow-under-sky.ron", 85.0, 0.0, 0.0, 0.057),
+    ("snow-under-sky.ron", 85.0, 30.0, 0.0, 0.055),
+    ("snow-under-sky.ron", 85.0, 30.0, 180.0, 0.060),
+    ("terraces.ron", 0.0, 0.0, 0.0, 0.0141),
+    ("terraces.ron", 0.0, 30.0, 0.0, 0.0148),
+    ("terraces.ron", 0.0, 30.0, 180.0, 0.0140),
+    ("terraces.ron", 60.0, 30.0, 180.0, 0.0174),
+];
+
+/// The goal of #17 at a view angle.
+fn goal(view_deg: f64) -> f64 {
+    if view_deg <= 60.0 { 0.01 } else { 0.04 }
+}
+
+#[test]
+fn every_preset_meets_the_accuracy_goal_or_its_known_bound() {
+    let mut failures = vec![];
+    let mut rows = 0;
+    for (path, text) in presets() {
+        let name = std::path::Path::new(&path)
+            .file_name()
+            .unwrap()
+            .to_string_lossy()
+            .into_owned();
+        let m = Material::from_ron(&text).unwrap();
+        let p = prepare(&path, &m);
+        for view in VIEWS {
+            for (light, azimuth) in LIGHTS {
+                let cfg = FootprintQuery::far(
+                    &p,
+                    direction(view.to_radians(), 0.0),
+                    direction(light.to_radians(), azimuth.to_radians()),
+                );
+                let f = p.filtered(&cfg);
+                let t = p.ground_truth(&cfg, RAYS, 1);
+                let peak = t.mean.iter().copied().fold(0.0f64, f64::max);
+                let mut excess = 0.0f64;
+                let mut signed = [0.0; 3];
+                for k in 0..3 {
+                    // Channels far below the brightest (a black colour stop) carry no share.
+                    if t.mean[k] <= 1e-3 * peak {
+                        continue;
+                    }
+                    signed[k] = (f[k] - t.mean[k]) / t.mean[k];
+                    let beyond = ((f[k] - t.mean[k]).abs() - 3.0 * t.std_error[k]).max(0.0);
+                    excess = excess.max(beyond / t.mean[k]);
+                }
+                let known = KNOWN
+                    .iter()
+                    .find(|k| k.0 == name && k.1 == view && k.2 == light && k.3 == azimuth)
+                    .map(|k| k.4);
+                let allowed = known.unwrap_or_else(|| goal(view));
+                eprintln!(
+                    "{name:<24} view {view:>2}° light {light:>2}°/{azimuth:>3}°: filtered − truth \
+                     {:+.2}% {:+.2}% {:+.2}%, beyond 3 s.e. {:.2}% (allowed {:.2}%{})",
+                    100.0 * signed[0],
+                    100.0 * signed[1],
+                    100.0 * signed[2],
+                    100.0 * excess,
+                    100.0 * allowed,
+                    if known.is_some() { ", known" } else { "" }
+                );
+                if known.is_some() && excess <= goal(view) {
+                    eprintln!("  (meets the goal now: remove its KNOWN entry)");
+                }
+                rows += 1;
+                if !(excess <= allowed) {
+                    failures.push(format!(
+                        "({name:?}, {view:.1}, {light:.1}, {azimuth:.1}, {excess:.4})"
+                    ));
+                }
+            }
+        }
+    }
+    assert!(rows >= 4 * VIEWS.len() * LIGHTS.len(), "the preset library");
+    assert!(
+        failures.is_empty(),
+        "beyond the goal or the known bound (as KNOWN entries):\n{}",
+        failures.join(",\n")
+    );
+}
