@@ -23,37 +23,6 @@ fn i1_large(t: f32) -> f32 {
     return 0.39894228 + t * (-0.03988024 + t * (-0.00362018 + t * (0.00163801 + t * (-0.01031555 + t * (0.02282967 + t * (-0.02895312 + t * (0.01787654 - t * 0.00420059)))))));
 }
 
-// A(x) = I1(x)/I0(x).
-fn bessel_ratio(x: f32) -> f32 {
-    let a = abs(x);
-    var r: f32;
-    if (a <= 3.75) {
-        let t = a / 3.75;
-        r = a * i1_over_x_small(t * t) / i0_small(t * t);
-    } else {
-        let t = 3.75 / a;
-        r = i1_large(t) / i0_large(t);
-    }
-    return select(r, -r, x < 0.0);
-}
-
-// A′(x) = 1 − A/x − A², in (0, ½].
-fn bessel_ratio_derivative(x: f32) -> f32 {
-    let a = abs(x);
-    var r: f32;
-    var q: f32;
-    if (a <= 3.75) {
-        let t = a / 3.75;
-        q = i1_over_x_small(t * t) / i0_small(t * t);
-        r = a * q;
-    } else {
-        let t = 3.75 / a;
-        r = i1_large(t) / i0_large(t);
-        q = r / a;
-    }
-    return clamp(1.0 - q - r * r, 1e-12, 0.5);
-}
-
 // (ln I0(x), A(x), A′(x)) in one evaluation of the polynomials.
 fn bessel_terms(x: f32) -> vec3<f32> {
     let a = abs(x);
@@ -78,12 +47,13 @@ fn bessel_terms(x: f32) -> vec3<f32> {
 
 // (A′, A″, A‴), the series below |x| = 0.3.
 fn bessel_ratio_derivatives(x: f32) -> vec3<f32> {
-    let a1 = bessel_ratio_derivative(x);
+    let t = bessel_terms(x);
+    let a = t.y;
+    let a1 = t.z;
     if (abs(x) < 0.3) {
         let x2 = x * x;
         return vec3<f32>(a1, x * (-0.375 + x2 * 5.0 / 24.0), -0.375 + 0.625 * x2);
     }
-    let a = bessel_ratio(x);
     let a2 = -a1 / x + a / (x * x) - 2.0 * a * a1;
     let a3 = -a2 / x + 2.0 * a1 / (x * x) - 2.0 * a / (x * x * x) - 2.0 * a1 * a1 - 2.0 * a * a2;
     return vec3<f32>(a1, a2, a3);
