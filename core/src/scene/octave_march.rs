@@ -50,6 +50,7 @@
 
 use crate::driver::noise::{MAX_LEVELS, Wave};
 use crate::scene::bound_grid::GridView;
+use crate::scene::field_grid::{FIELD_SETTLE, FieldStep, FieldView};
 use crate::scene::local_slope::LocalSlope;
 use crate::scene::march::{FAST_WIDTH, March, refine};
 use glam::{DVec2, DVec3};
@@ -91,13 +92,16 @@ pub struct OctaveSurface<'a> {
     pub g_slope: Option<LocalSlope<'a>>,
     /// Bounds of f over boxes, to skip what they prove clear ([`crate::scene::bound_grid`]).
     pub grid: Option<GridView<'a>>,
+    /// f read from a table with error bounds, to step and settle on near the surface without
+    /// summing the waves ([`crate::scene::field_grid`]).
+    pub field: Option<FieldView<'a>>,
 }
 
 /// Most grid lookups per [`OctaveSurface::grid_skip`].
 pub const GRID_TRIES: usize = 24;
 
 /// Per-ray constants of the waves: amplitudes, frequencies along the ray and the level bounds.
-struct RayWaves {
+pub(crate) struct RayWaves {
     /// `(a_i, ω_i, φ_i + 2π k_i·o_xy)` per wave.
     terms: Vec<(f64, f64, f64)>,
     /// `Σ|a_i|`: with the attenuations, the level-of-detail surface's own slab (module docs).
@@ -106,6 +110,13 @@ struct RayWaves {
     resid: [f64; MAX_LEVELS],
     lip: [f64; MAX_LEVELS],
     curv: [f64; MAX_LEVELS],
+}
+
+impl RayWaves {
+    /// Level l's `(R_l, K_l, M_l)`.
+    pub(crate) fn bounds(&self, l: usize) -> (f64, f64, f64) {
+        (self.resid[l], self.lip[l], self.curv[l])
+    }
 }
 
 impl OctaveSurface<'_> {
@@ -197,12 +208,36 @@ impl OctaveSurface<'_> {
         // A ray that starts clear of the surface (a camera ray from the slab's top) may settle on it
         // (module docs); one leaving the surface (a shadow ray) must cross it to be stopped.
         let settle = HIT_GAP * top;
+        let settle_f = FIELD_SETTLE * top;
         let mut may_settle = None;
         let mut skip = 0.0;
         for _ in 0..1_000_000 {
             let z = o.z + d.z * t;
             if (d.z >= 0.0 && z > top) || (d.z < 0.0 && z < -top - 1.0) {
                 return None;
+            }
+            // Near the surface, step (and let a camera ray settle) on the table of f; a ray clear of
+            // the surface by 1000 ε on it may settle (a camera ray), as after an exact evaluation.
+            if let Some(fv) = self.field {
+                let crawl = may_settle == Some(true);
+                match self.field_step(
+                    &fv,
+                    o + d * t,
+                    d,
+                    &rw.bounds(last),
+                    &height_of,
+                    settle_f,
+                    crawl,
+                ) {
+                    FieldStep::Settle if crawl && t > 0.0 => return Some(t),
+                    FieldStep::Clear(s, gap) if may_settle.is_some() || gap > 1e3 * settle => {
+                        may_settle.get_or_insert(true);
+                        (prev_t, prev_g) = (t, gap);
+                        t += s;
+                        continue;
+                    }
+                    _ => {}
+                }
             }
             // After the first evaluation (which decides whether the ray may settle), skip what the
             // grid proves clear.
@@ -251,7 +286,7 @@ impl OctaveSurface<'_> {
                 }
                 let found =
                     (gap >= 0.0).then(|| (self.step(gap, fd, rw.lip[l], rw.curv[l], d.z, sg), gap));
-                if let Some((s, gap)) = self.local_step(found, z - hf, f, fd, l, &rw, d.z) {
+                if let Some((s, gap)) = self.local_step(found, z - hf, f, fd, rw.bounds(l), d.z) {
                     known = known.max(gap);
                     if best.is_none_or(|b| s > b.0) {
                         best = Some((s, l, gap));
@@ -298,7 +333,7 @@ impl OctaveSurface<'_> {
     /// The longer of the first- and second-order safe steps (module docs) from gap `gap ≥ 0` with
     /// the level's slope `fd`, Lipschitz `lip` and curvature `curv`. Infinite when the gap cannot
     /// shrink.
-    fn step(&self, gap: f64, fd: f64, lip: f64, curv: f64, dz: f64, sg: f64) -> f64 {
+    pub(crate) fn step(&self, gap: f64, fd: f64, lip: f64, curv: f64, dz: f64, sg: f64) -> f64 {
         let rate = sg * lip - dz;
         let first = if rate > 0.0 {
             gap / rate
@@ -384,64 +419,6 @@ impl OctaveSurface<'_> {
         Some(a)
     }
 
-    /// The furthest `t1 > t` to which [`GridView`] proves the ray clear of the surface, with the
-    /// gap's lower bound there, or `None`. Segments from the last clear point double while they are
-    /// clear and halve when not, down to one cell (`len` carries the length between calls).
-    fn grid_skip(
-        &self,
-        gv: &GridView,
-        o: DVec3,
-        d: DVec3,
-        t: f64,
-        len: &mut f64,
-        height_of: &impl Fn(f64) -> f64,
-    ) -> Option<(f64, f64)> {
-        let cell = gv.grid.cell;
-        let mut best: Option<(f64, f64)> = None;
-        let mut l = len.max(2.0 * cell);
-        for _ in 0..GRID_TRIES {
-            let t0 = best.map_or(t, |b| b.0);
-            let t1 = t0 + l;
-            match self.grid_gap(gv, o + d * t0, o + d * t1, height_of) {
-                Some(g) if g > 0.0 => {
-                    best = Some((t1, g));
-                    l *= 2.0;
-                }
-                _ => {
-                    if l <= cell {
-                        break;
-                    }
-                    l *= 0.5;
-                }
-            }
-        }
-        *len = l;
-        best
-    }
-
-    /// A lower bound of the gap along the segment from `a` to `b` from the grid's range of f over
-    /// its box: the segment's lowest z minus the highest surface that range allows (`σ_h·G(hi)`
-    /// for the identity and rising curves; `σ_h·(G(mid) + L·(hi − lo)/2)` with the local Lipschitz constant L of a
-    /// curve; G at one end of the range when G is monotone). `None` where the box leaves the grid.
-    fn grid_gap(
-        &self,
-        gv: &GridView,
-        a: DVec3,
-        b: DVec3,
-        height_of: &impl Fn(f64) -> f64,
-    ) -> Option<f64> {
-        let (lo, hi) = gv.range(DVec2::new(a.x, a.y), DVec2::new(b.x, b.y))?;
-        let h = if let Some(rising) = self.monotone {
-            height_of(if rising { hi } else { lo })
-        } else {
-            let l = self
-                .g_slope
-                .map_or(self.g_lip, |gs| gs.lipschitz_on(lo, hi).min(self.g_lip));
-            height_of(0.5 * (lo + hi)) + self.sigma_h * l * 0.5 * (hi - lo)
-        };
-        Some(a.z.min(b.z) - h)
-    }
-
     /// Improve the level's `(step, gap)` found with the global `g_lip` (`None` when that gap is
     /// negative) by the local Lipschitz constant of G ([`LocalSlope`]): for a trial length s, f stays
     /// within `f_l ± (R_l + K_l s)` along it, so the level's gap and step bounds hold there with G′
@@ -449,14 +426,13 @@ impl OctaveSurface<'_> {
     /// 8·max(step, min_step) while they succeed (at most four). `above` is `z − σ_h·G(f_l)`; the
     /// gap returned is a lower bound of the true gap at the point.
     #[allow(clippy::too_many_arguments)]
-    fn local_step(
+    pub(crate) fn local_step(
         &self,
         found: Option<(f64, f64)>,
         above: f64,
         f: f64,
         fd: f64,
-        l: usize,
-        rw: &RayWaves,
+        (resid, lip, curv): (f64, f64, f64),
         dz: f64,
     ) -> Option<(f64, f64)> {
         let Some(gs) = self.g_slope else {
@@ -465,7 +441,6 @@ impl OctaveSurface<'_> {
         if found.is_some_and(|(s, _)| !s.is_finite()) {
             return found;
         }
-        let (resid, lip) = (rw.resid[l], rw.lip[l]);
         let mut best = found;
         let mut trial = 8.0 * found.map_or(0.0, |b| b.0).max(self.min_step);
         for _ in 0..4 {
@@ -476,7 +451,7 @@ impl OctaveSurface<'_> {
             if !(gap >= 0.0) {
                 break;
             }
-            let s = self.step(gap, fd, lip, rw.curv[l], dz, sg);
+            let s = self.step(gap, fd, lip, curv, dz, sg);
             let step = s.min(trial);
             best = match best {
                 Some((b, g0)) => Some((b.max(step), g0.max(gap))),
@@ -688,6 +663,135 @@ mod tests {
             assert!(
                 differ <= 1,
                 "{} (grid {grid}): {differ} of 240 rays differ",
+                m.name
+            );
+        }
+    }
+
+    /// With a table of f ([`crate::scene::field_grid`], over part of the rays' range so rays also
+    /// cross its edge), on the explicit and the level-of-detail surface: camera rays stop within
+    /// `FIELD_SETTLE·top` above the surface, never past the reference's first crossing and with no
+    /// crossing before (dense scan); all but a few stop where the reference does (within the
+    /// settle band's width along the ray; the rest skim a crest within the band); shadow rays agree
+    /// with the reference's hit or escape.
+    #[test]
+    fn the_field_table_march_settles_on_the_first_crossing() {
+        use crate::scene::field_grid::FIELD_SETTLE;
+        let mut rng = 23u64;
+        for m in materials() {
+            let mut fast = Evaluator::new(&m).unwrap();
+            fast.surface = fast
+                .surface
+                .clone()
+                .with_field_grid(DVec2::splat(15.0), 256);
+            let field = fast.surface.field.clone().expect("a table");
+            let half = 0.5 * field.n as f64 * field.cell;
+            let mut reference = fast.clone();
+            reference.surface.march = March::Reference;
+            let s = &fast.surface;
+            let scale = s.driver.finest_scale();
+            let (mut far, mut shadow_differ, mut n, mut settled) = (0, 0, 0, 0);
+            for i in 0..300 {
+                let lod = i % 3 == 2;
+                let fp = Footprint::isotropic(scale * [0.05, 0.5][i % 2]);
+                let theta = (20.0 + 68.0 * splitmix(&mut rng)).to_radians();
+                let d = -direction(theta, TAU * splitmix(&mut rng));
+                let o = DVec3::new(
+                    15.0 + 2.4 * half * (splitmix(&mut rng) - 0.5),
+                    15.0 + 2.4 * half * (splitmix(&mut rng) - 0.5),
+                    s.h_max * 1.001 + 1e-6,
+                );
+                let height = |p: DVec3| {
+                    let x = DVec2::new(p.x, p.y);
+                    if lod {
+                        fast.lod_height(x, fp)
+                    } else {
+                        s.height(x)
+                    }
+                };
+                let (tf, tr) = if lod {
+                    (fast.lod_march(o, d, fp), reference.lod_march(o, d, fp))
+                } else {
+                    let t = |s: &Surface| match s.march(o, d) {
+                        Trace::Hit(t) => Some(t),
+                        Trace::Escape => None,
+                    };
+                    (t(s), t(&reference.surface))
+                };
+                let (Some(tf), Some(tr)) = (tf, tr) else {
+                    panic!("{}: a downward ray hits", m.name)
+                };
+                n += 1;
+                let top = s
+                    .h_max
+                    .min(s.height_of(0.0).abs() + s.sigma_h * s.g_lip * field.amplitude_sum);
+                let gap = o.z + d.z * tf - height(o + d * tf);
+                assert!(
+                    gap > -1e-9 && gap <= FIELD_SETTLE * top * 1.001,
+                    "{} (lod {lod}): gap {gap} at the hit, settle {}",
+                    m.name,
+                    FIELD_SETTLE * top
+                );
+                assert!(
+                    tf <= tr * (1.0 + 1e-9) + 1e-12,
+                    "{}: {tf} past the first crossing {tr}",
+                    m.name
+                );
+                for j in 0..4000 {
+                    let q = o + d * (tf * f64::from(j) / 4000.0);
+                    assert!(
+                        q.z - height(q) > -1e-9,
+                        "{}: a crossing before the hit",
+                        m.name
+                    );
+                }
+                if !lod {
+                    // Whether the table settled it (the point the march stopped at is one where it
+                    // may), rather than the waves' sum.
+                    let os = s.octaves(None).unwrap();
+                    let rw = os.ray(o, d);
+                    let last = os.ends.len().clamp(1, crate::driver::noise::MAX_LEVELS) - 1;
+                    let fv = os.field.unwrap();
+                    let at = os.field_step(
+                        &fv,
+                        o + d * tf,
+                        d,
+                        &rw.bounds(last),
+                        &|f| s.height_of(f),
+                        FIELD_SETTLE * top * (1.0 + 1e-12) + 1e-300,
+                        true,
+                    );
+                    settled += usize::from(at == crate::scene::field_grid::FieldStep::Settle);
+                }
+                // Within the band's width along the ray (rate ≥ |d_z| where the gap shrinks).
+                if tr - tf > 2.0 * FIELD_SETTLE * top / d.z.abs() {
+                    far += 1;
+                }
+                if !lod {
+                    let l = direction(
+                        (5.0 + 80.0 * splitmix(&mut rng)).to_radians(),
+                        TAU * splitmix(&mut rng),
+                    );
+                    let p = o + d * tr;
+                    let hit = |s: &Surface| matches!(s.march(p, l), Trace::Hit(_));
+                    if hit(s) != hit(&reference.surface) {
+                        shadow_differ += 1;
+                    }
+                }
+            }
+            eprintln!(
+                "{}: {far} of {n} camera rays skim a crest, {settled} settled on the table, {shadow_differ} shadow rays differ",
+                m.name
+            );
+            assert!(far <= n / 50, "{}: {far} of {n} rays stop early", m.name);
+            assert!(
+                settled * 5 >= n,
+                "{}: the table settled {settled} of {n}",
+                m.name
+            );
+            assert!(
+                shadow_differ <= 1,
+                "{}: {shadow_differ} shadow rays differ",
                 m.name
             );
         }

@@ -12,6 +12,7 @@ use crate::material::transfer::TransferFunction;
 use crate::math::piecewise::PiecewisePoly;
 use crate::scene::bound_grid::{BoundGrid, GridView};
 use crate::scene::camera::Camera;
+use crate::scene::field_grid::{FieldGrid, FieldView};
 use crate::scene::local_slope::LocalSlope;
 use crate::scene::march::{March, march_heightfield};
 use crate::scene::octave_march::OctaveSurface;
@@ -47,6 +48,9 @@ pub struct Surface {
     /// Bounds of a noise driver over a region, which the octave march uses to skip what is clear
     /// ([`Surface::with_bound_grid`]; `None`: no skipping).
     pub grid: Option<BoundGrid>,
+    /// A table of a noise driver's f over a region, which the octave march steps and settles on
+    /// near the surface ([`Surface::with_field_grid`]; `None`: it sums the waves).
+    pub field: Option<FieldGrid>,
 }
 
 /// Result of marching a ray.
@@ -90,6 +94,7 @@ impl Surface {
             levels,
             transfer_poly,
             grid: None,
+            field: None,
             g_lip: transfer.max_derivative(),
             driver,
             sigma_h,
@@ -220,6 +225,7 @@ impl Surface {
                 tail: 0.0,
             }),
             grid: self.grid.as_ref().map(GridView::explicit),
+            field: self.field.as_ref().map(FieldView::explicit),
         })
     }
 
@@ -228,6 +234,15 @@ impl Surface {
     pub fn with_bound_grid(mut self, centre: DVec2, half: f64) -> Self {
         if let DriverField::Noise(n) = &self.driver {
             self.grid = BoundGrid::build(n, centre, half);
+        }
+        self
+    }
+
+    /// This surface with a [`FieldGrid`] of `cells`² cells of its noise driver around `centre`
+    /// (unchanged for an image driver).
+    pub fn with_field_grid(mut self, centre: DVec2, cells: usize) -> Self {
+        if let DriverField::Noise(n) = &self.driver {
+            self.field = FieldGrid::around(n, centre, cells);
         }
         self
     }
