@@ -10,6 +10,7 @@ use lodestone_core::microfacet::effective_height::{
 };
 use lodestone_core::microfacet::masking_shadowing::AZIMUTH_CORRELATION;
 use lodestone_core::scene::bound_grid::GRID_MARGIN_F32;
+use lodestone_core::scene::field_grid::FIELD_SETTLE;
 use lodestone_core::scene::march::FAST_WIDTH_F32;
 use lodestone_core::scene::march::RELAXATION;
 use lodestone_core::scene::octave_march::{GRID_TRIES, HIT_GAP_F32};
@@ -167,6 +168,7 @@ pub fn wgsl_prelude() -> &'static str {
             ("HIT_GAP", HIT_GAP_F32),
             ("FAST_WIDTH", FAST_WIDTH_F32),
             ("GRID_MARGIN", GRID_MARGIN_F32),
+            ("FIELD_SETTLE", FIELD_SETTLE),
         ];
         for (name, v) in floats {
             let _ = writeln!(s, "const {name}: f32 = {:?};", v as f32);

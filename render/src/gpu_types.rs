@@ -238,6 +238,23 @@ gpu_struct! {
         grid_y0: f32 => "f32",
         /// Σ|a_i| of the waves (the grid's tails and f32 margin are relative to it).
         grid_amp: f32 => "f32",
+        /// Offset of the field table's vertices (`[f, c·f_x, c·f_y, c²·f_xy]` each; core's
+        /// `scene::field_grid::FieldGrid`).
+        field_offset: u32 => "u32",
+        /// Cells per side of the field table (0: no table).
+        field_n: u32 => "u32",
+        /// Side of a cell of the field table.
+        field_cell: f32 => "f32",
+        /// The field table's lower-left vertex relative to the camera target, x.
+        field_x0: f32 => "f32",
+        /// The field table's lower-left vertex relative to the camera target, y.
+        field_y0: f32 => "f32",
+        /// Bound of the table's value error, with the f32 margin.
+        field_error: f32 => "f32",
+        /// Bound of the table's x-slope error, with the f32 margin.
+        field_slope_error_x: f32 => "f32",
+        /// Bound of the table's y-slope error, with the f32 margin.
+        field_slope_error_y: f32 => "f32",
         /// Monotonicity of the transfer function: 1 never decreasing (the identity too), 2 never
         /// increasing, 0 neither (core's `OctaveSurface::monotone`).
         transfer_monotone: u32 => "u32",

@@ -25,6 +25,7 @@ use lodestone_core::microfacet::slope_density::NoiseSlopes;
 use lodestone_core::microfacet::visible_slopes::slope_rule;
 use lodestone_core::scene::bound_grid::BoundGrid;
 use lodestone_core::scene::camera::{Camera, PIXEL_SIGMA};
+use lodestone_core::scene::field_grid::{FIELD_MARGIN_F32, FieldGrid};
 use lodestone_core::scene::march::March;
 use lodestone_core::scene::shape::Shape;
 use lodestone_core::scene::surface::Surface;
@@ -707,6 +708,58 @@ pub fn push_bound_grid(
     d.params.grid_amp = noise.waves.iter().map(|w| w.amplitude.abs()).sum::<f64>() as f32;
 }
 
+/// Cells per side of the field table the GPU march reads (core's [`FieldGrid::around`]): 512²
+/// cells, 4.2 MB.
+pub const GPU_FIELD_CELLS: usize = 512;
+
+/// Append the field table of a noise driver around `target` to `d` (the octave march's steps near
+/// the surface; [`lodestone_core::scene::field_grid`]) under the same conditions as the bound grid,
+/// its origin relative to `target` like the waves and its error bounds widened by
+/// [`FIELD_MARGIN_F32`] for the f32 arithmetic. Nothing otherwise (`field_n` stays 0), or when the
+/// environment variable `LODESTONE_NO_FIELD` is set: the march then sums the waves everywhere, so
+/// `lodestone bench` can time both on the same build.
+pub fn push_field_grid(
+    prepared: &Evaluator,
+    target: [f64; 2],
+    features: FeatureSet,
+    d: &mut MaterialData,
+) {
+    let s = &prepared.surface;
+    let DriverField::Noise(noise) = &s.driver else {
+        return;
+    };
+    if s.march != March::Fast || !features.contains(Feature::Relief) || !(s.sigma_h > 0.0) {
+        return;
+    }
+    let centre = DVec2::from(target);
+    if std::env::var_os("LODESTONE_NO_FIELD").is_some() {
+        return;
+    }
+    let Some(field) = FieldGrid::around(noise, centre, GPU_FIELD_CELLS) else {
+        return;
+    };
+    let start = d.data.len();
+    d.params.field_offset = start as u32;
+    for v in &field.vertices {
+        d.data.extend(v);
+    }
+    d.segments.push(("field table", (d.data.len() - start) * 4));
+    let amp = field.amplitude_sum;
+    let fine = noise
+        .waves
+        .iter()
+        .map(|w| std::f64::consts::TAU * w.k.abs())
+        .fold(DVec2::ZERO, DVec2::max);
+    let margin = FIELD_MARGIN_F32 * amp;
+    d.params.field_n = field.n as u32;
+    d.params.field_cell = field.cell as f32;
+    d.params.field_x0 = (field.origin.x - centre.x) as f32;
+    d.params.field_y0 = (field.origin.y - centre.y) as f32;
+    d.params.field_error = (field.error + margin) as f32;
+    d.params.field_slope_error_x = (field.slope_error.x + margin * fine.x) as f32;
+    d.params.field_slope_error_y = (field.slope_error.y + margin * fine.y) as f32;
+}
+
 impl GpuMaterial {
     /// Upload a prepared material with coordinates relative to `target` (the camera target), with
     /// only the data its features use ([`material_data_for`]); drawn by pipelines specialised to
@@ -746,6 +799,7 @@ impl GpuMaterial {
         };
         let mut d = material_data_for(prepared, target, uses);
         push_bound_grid(prepared, target, uses, &mut d);
+        push_field_grid(prepared, target, uses, &mut d);
         let MaterialData {
             mut data,
             params,

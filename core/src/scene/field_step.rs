@@ -2,7 +2,7 @@
 //! the table's bounds instead of the waves' sum, and let a camera ray settle where they prove it on
 //! the surface.
 
-use crate::scene::field_grid::{FieldStep, FieldView};
+use crate::scene::field_grid::{FieldProbe, FieldStep, FieldView};
 use crate::scene::octave_march::OctaveSurface;
 use glam::{DVec2, DVec3};
 
@@ -41,7 +41,7 @@ impl OctaveSurface<'_> {
             return FieldStep::Unsure;
         }
         if hi <= settle {
-            return FieldStep::Settle;
+            return self.field_crossing_ahead(fv, p, d, pr, hi + 2.0 * band, height_of);
         }
         if !(lo >= 2.0 * band || crawl && 4.0 * band <= settle) {
             return FieldStep::Unsure;
@@ -56,6 +56,40 @@ impl OctaveSurface<'_> {
         match self.local_step(found, above, pr.value, fd, (e, lip, curv), d.z) {
             Some((s, gap)) if s.is_finite() && s >= self.min_step => FieldStep::Clear(s, gap),
             _ => FieldStep::Unsure,
+        }
+    }
+
+    /// Where the table puts the gap within `[0, settle]`: [`FieldStep::Settle`] only when it also
+    /// proves a crossing just ahead, so a camera ray that skims a crest within the band goes on
+    /// (with the waves' sum) instead of stopping on it. From the table's rate of descent of the gap
+    /// (`σ_h G′(F)·F′ − d_z`, by a difference over the table's error), the point `δ = 2·reach/rate`
+    /// ahead (`reach` = the gap's upper bound plus the band) must be certainly below the surface.
+    fn field_crossing_ahead(
+        &self,
+        fv: &FieldView,
+        p: DVec3,
+        d: DVec3,
+        pr: FieldProbe,
+        reach: f64,
+        height_of: &impl Fn(f64) -> f64,
+    ) -> FieldStep {
+        let eps = pr.error / pr.slope.abs().max(1e-300);
+        let rate = (height_of(pr.value + pr.slope * eps) - height_of(pr.value)) / eps - d.z;
+        if !(rate > 0.0 && eps.is_finite()) {
+            return FieldStep::Unsure;
+        }
+        let q = p + d * (2.0 * reach / rate);
+        let Some(pq) = fv.probe(DVec2::new(q.x, q.y), DVec2::new(d.x, d.y)) else {
+            return FieldStep::Unsure;
+        };
+        let e = pq.error;
+        let g = self.g_slope.map_or(self.g_lip, |gs| {
+            gs.lipschitz_on(pq.value - e, pq.value + e).min(self.g_lip)
+        });
+        if q.z - height_of(pq.value) + self.sigma_h * g * e < 0.0 {
+            FieldStep::Settle
+        } else {
+            FieldStep::Unsure
         }
     }
 }

@@ -669,7 +669,8 @@ mod tests {
     }
 
     /// With a table of f ([`crate::scene::field_grid`], over part of the rays' range so rays also
-    /// cross its edge), on the explicit and the level-of-detail surface: camera rays stop within
+    /// cross its edge) on the explicit surface (and, unchanged, the level-of-detail march beside
+    /// it, which does not use the table): camera rays stop within
     /// `FIELD_SETTLE·top` above the surface, never past the reference's first crossing and with no
     /// crossing before (dense scan); all but a few stop where the reference does (within the
     /// settle band's width along the ray; the rest skim a crest within the band); shadow rays agree
