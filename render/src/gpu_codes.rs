@@ -8,6 +8,7 @@ use crate::gpu_types::{GpuStruct, MaterialParams};
 use lodestone_core::microfacet::effective_height::{
     FIT_ALPHA_MU, FIT_ALPHA_SIGMA, FIT_BETA_MU, FIT_BETA_SIGMA,
 };
+use lodestone_core::microfacet::height_mixture::{MAX_KNOT_EDGES, MIXTURE_BINS};
 use lodestone_core::microfacet::masking_shadowing::AZIMUTH_CORRELATION;
 use lodestone_core::scene::bound_grid::GRID_MARGIN_F32;
 use lodestone_core::scene::field_grid::FIELD_SETTLE;
@@ -154,7 +155,11 @@ pub fn wgsl_prelude() -> &'static str {
             HeightFilterCode::WGSL,
             MarchCode::WGSL,
         ];
-        let counts: &[(&str, u32)] = &[("GRID_TRIES", GRID_TRIES as u32)];
+        let counts: &[(&str, u32)] = &[
+            ("GRID_TRIES", GRID_TRIES as u32),
+            ("MIXTURE_BINS", MIXTURE_BINS as u32),
+            ("MAX_KNOT_EDGES", MAX_KNOT_EDGES as u32),
+        ];
         for (name, v) in sets.into_iter().flatten().chain(counts) {
             let _ = writeln!(s, "const {name}: u32 = {v}u;");
         }

@@ -29,8 +29,9 @@ pub enum TransferSlopes {
     Gaussian,
 }
 
-/// Bins of equal probability before the knots are added.
-pub const MIXTURE_BINS: usize = 8;
+/// Bins of equal probability before the knots are added: 16 (8 left terraces 1.3–1.6% off the
+/// ray-traced truth at 0° and 60°, 16 brings it to 0.6–0.9%; docs/design.md).
+pub const MIXTURE_BINS: usize = 16;
 
 /// Knots of the curve used as bin edges, at most (inside the footprint's quantile range; when
 /// more fall inside, every k-th is used, k the smallest stride that fits).

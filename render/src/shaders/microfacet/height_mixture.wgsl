@@ -2,14 +2,13 @@
 // `//#if feature` blocks are stripped by render/src/specialize.rs when a scene does not use the feature.
 
 //#if transfer_mixture
-const MIXTURE_BINS: u32 = 8u;
-const MAX_KNOT_EDGES: u32 = 16u;
+// MIXTURE_BINS and MAX_KNOT_EDGES come from core (the prelude, gpu_codes.rs).
 const KNOT_MARGIN: f32 = 1e-6;
 
 // The edges mixture_edges writes (at most MIXTURE_BINS + MAX_KNOT_EDGES + 1), and the knots'
 // quantiles it merges in.
-var<private> mixture_edge_buf: array<f32, 25>;
-var<private> mixture_knot_buf: array<f32, 16>;
+var<private> mixture_edge_buf: array<f32, MIXTURE_BINS + MAX_KNOT_EDGES + 1u>;
+var<private> mixture_knot_buf: array<f32, MAX_KNOT_EDGES>;
 
 // mixture_edges: the bin edges in u = Φ(z) for the transfer curve's knots (the polynomial's, at
 // params.tp_offset) and the footprint's N(mean, sd²), into mixture_edge_buf; returns their count.
