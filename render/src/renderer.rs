@@ -10,6 +10,7 @@ use crate::gpu_types::{MaterialParams, ViewParams};
 use crate::specialize::{SpecializeError, view_source_for};
 use glam::{DVec2, DVec3};
 use lodestone_core::driver::field::{DriverField, TiledImage};
+use lodestone_core::driver::noise::SumOfSines;
 use lodestone_core::eval::Evaluator;
 use lodestone_core::material::color_terms::CombineMode;
 use lodestone_core::material::colormap::linear_to_srgb;
@@ -667,6 +668,17 @@ pub fn material_data_for(
     }
 }
 
+/// The noise driver the octave march sums, when the march is fast, the scene has relief and σ_h > 0:
+/// what the bound grid and the field table are built from (`None` otherwise).
+fn marched_noise(prepared: &Evaluator, features: FeatureSet) -> Option<&SumOfSines> {
+    let s = &prepared.surface;
+    let DriverField::Noise(noise) = &s.driver else {
+        return None;
+    };
+    (s.march == March::Fast && features.contains(Feature::Relief) && s.sigma_h > 0.0)
+        .then_some(noise)
+}
+
 /// Cells per side of the bound grid the GPU march reads (core's [`BoundGrid::around`]): 512² cells,
 /// a pyramid of 2.8 MB, built in tens of milliseconds.
 pub const GPU_GRID_CELLS: usize = 512;
@@ -681,13 +693,9 @@ pub fn push_bound_grid(
     features: FeatureSet,
     d: &mut MaterialData,
 ) {
-    let s = &prepared.surface;
-    let DriverField::Noise(noise) = &s.driver else {
+    let Some(noise) = marched_noise(prepared, features) else {
         return;
     };
-    if s.march != March::Fast || !features.contains(Feature::Relief) || !(s.sigma_h > 0.0) {
-        return;
-    }
     let centre = DVec2::from(target);
     let Some(grid) = BoundGrid::around(noise, centre, GPU_GRID_CELLS) else {
         return;
@@ -724,13 +732,9 @@ pub fn push_field_grid(
     features: FeatureSet,
     d: &mut MaterialData,
 ) {
-    let s = &prepared.surface;
-    let DriverField::Noise(noise) = &s.driver else {
+    let Some(noise) = marched_noise(prepared, features) else {
         return;
     };
-    if s.march != March::Fast || !features.contains(Feature::Relief) || !(s.sigma_h > 0.0) {
-        return;
-    }
     let centre = DVec2::from(target);
     if std::env::var_os("LODESTONE_NO_FIELD").is_some() {
         return;
