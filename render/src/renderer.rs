@@ -683,11 +683,10 @@ fn marched_noise(prepared: &Evaluator, features: FeatureSet) -> Option<&SumOfSin
 /// a pyramid of 2.8 MB, built in tens of milliseconds.
 pub const GPU_GRID_CELLS: usize = 512;
 
-/// Append the bound grid of a noise driver's explicit surface around `target` to `d` (the octave
-/// march's skips; [`lodestone_core::scene::bound_grid`]) when the march is fast and the scene has
-/// relief: the pyramid's levels one after the other, `[lo, hi]` per cell, in coordinates relative to
-/// `target` like the waves. Nothing otherwise (`grid_n` stays 0: no skips).
-pub fn push_bound_grid(
+/// Append the octave march's tables of a noise driver's explicit surface around `target` to `d`
+/// when the march is fast and the scene has relief ([`push_bound_grid`], [`push_field_grid`]);
+/// nothing otherwise (`grid_n` and `field_n` stay 0: the march sums the waves everywhere).
+pub fn push_march_tables(
     prepared: &Evaluator,
     target: [f64; 2],
     features: FeatureSet,
@@ -697,6 +696,14 @@ pub fn push_bound_grid(
         return;
     };
     let centre = DVec2::from(target);
+    push_bound_grid(noise, centre, d);
+    push_field_grid(noise, centre, d);
+}
+
+/// Append the bound grid of `noise` around `centre` to `d` (the octave march's skips;
+/// [`lodestone_core::scene::bound_grid`]): the pyramid's levels one after the other, `[lo, hi]` per
+/// cell, in coordinates relative to `centre` like the waves.
+fn push_bound_grid(noise: &SumOfSines, centre: DVec2, d: &mut MaterialData) {
     let Some(grid) = BoundGrid::around(noise, centre, GPU_GRID_CELLS) else {
         return;
     };
@@ -720,22 +727,12 @@ pub fn push_bound_grid(
 /// cells, 4.2 MB.
 pub const GPU_FIELD_CELLS: usize = 512;
 
-/// Append the field table of a noise driver around `target` to `d` (the octave march's steps near
-/// the surface; [`lodestone_core::scene::field_grid`]) under the same conditions as the bound grid,
-/// its origin relative to `target` like the waves and its error bounds widened by
-/// [`FIELD_MARGIN_F32`] for the f32 arithmetic. Nothing otherwise (`field_n` stays 0), or when the
-/// environment variable `LODESTONE_NO_FIELD` is set: the march then sums the waves everywhere, so
-/// `lodestone bench` can time both on the same build.
-pub fn push_field_grid(
-    prepared: &Evaluator,
-    target: [f64; 2],
-    features: FeatureSet,
-    d: &mut MaterialData,
-) {
-    let Some(noise) = marched_noise(prepared, features) else {
-        return;
-    };
-    let centre = DVec2::from(target);
+/// Append the field table of `noise` around `centre` to `d` (the octave march's steps near the
+/// surface; [`lodestone_core::scene::field_grid`]), its origin relative to `centre` like the waves
+/// and its error bounds widened by [`FIELD_MARGIN_F32`] for the f32 arithmetic. Nothing when the
+/// environment variable `LODESTONE_NO_FIELD` is set (`field_n` stays 0): the march then sums the
+/// waves near the surface, so `lodestone bench` can time both on the same build.
+fn push_field_grid(noise: &SumOfSines, centre: DVec2, d: &mut MaterialData) {
     if std::env::var_os("LODESTONE_NO_FIELD").is_some() {
         return;
     }
@@ -802,8 +799,7 @@ impl GpuMaterial {
             features
         };
         let mut d = material_data_for(prepared, target, uses);
-        push_bound_grid(prepared, target, uses, &mut d);
-        push_field_grid(prepared, target, uses, &mut d);
+        push_march_tables(prepared, target, uses, &mut d);
         let MaterialData {
             mut data,
             params,

@@ -278,13 +278,14 @@ impl<'a> GridView<'a> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::driver::noise::NoiseParams;
     use crate::material::{Driver, Material};
     use crate::math::random::splitmix;
 
-    fn noise(octaves: u32, components: u32) -> SumOfSines {
+    /// The default material's noise with `octaves` and `components` (also the field table's tests).
+    pub(crate) fn noise(octaves: u32, components: u32) -> SumOfSines {
         Material {
             driver: Driver::Noise(NoiseParams {
                 octaves,

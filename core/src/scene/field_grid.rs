@@ -295,22 +295,8 @@ pub enum FieldStep {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::driver::noise::NoiseParams;
-    use crate::material::{Driver, Material};
     use crate::math::random::splitmix;
-
-    fn noise(octaves: u32, components: u32) -> SumOfSines {
-        Material {
-            driver: Driver::Noise(NoiseParams {
-                octaves,
-                components,
-                ..NoiseParams::default()
-            }),
-            ..Material::default()
-        }
-        .noise()
-        .expect("a noise driver")
-    }
+    use crate::scene::bound_grid::tests::noise;
 
     fn uniform(state: &mut u64) -> f64 {
         splitmix(state)
