@@ -132,6 +132,13 @@ pub enum Command {
         /// Timed frames per mode (after one warm-up frame; 1 to 1000).
         #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
         frames: u32,
+        /// Modes to time (comma-separated; the flat reference is always timed). Columns of modes
+        /// left out print NaN.
+        #[arg(long, value_enum, value_delimiter = ',', default_values_t = BenchMode::all())]
+        modes: Vec<BenchMode>,
+        /// Skip the reference march (its /ref columns print NaN): a quicker A/B of the fast march.
+        #[arg(long)]
+        no_reference: bool,
         /// Print JSON.
         #[arg(long)]
         json: bool,
@@ -255,6 +262,41 @@ pub enum RenderMode {
     Error,
     /// Every mode and every error map, into a directory.
     All,
+}
+
+/// A view mode `bench` can time.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum BenchMode {
+    /// The naive view.
+    Naive,
+    /// The view-independent filtered view.
+    ViewIndependent,
+    /// The filtered view.
+    Filtered,
+    /// Ground truth (one sample per pixel per frame).
+    Truth,
+}
+
+impl BenchMode {
+    /// Every mode, in the table's order.
+    pub fn all() -> Vec<Self> {
+        vec![
+            Self::Naive,
+            Self::ViewIndependent,
+            Self::Filtered,
+            Self::Truth,
+        ]
+    }
+
+    /// The mode's name in the bench's JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Naive => "naive",
+            Self::ViewIndependent => "view_independent",
+            Self::Filtered => "filtered",
+            Self::Truth => "truth",
+        }
+    }
 }
 
 /// How marches step and refine the crossing they find (`lodestone_core::scene::march::March`).

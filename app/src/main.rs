@@ -248,6 +248,8 @@ fn run(cli: Cli) -> Result<()> {
             view_deg,
             distance,
             presets,
+            modes,
+            no_reference,
         }) => {
             let mut sweep = vec![];
             if presets.is_empty() {
@@ -266,6 +268,8 @@ fn run(cli: Cli) -> Result<()> {
                 distance,
                 size,
                 frames,
+                modes: modes.iter().map(|m| m.name()).collect(),
+                reference: !no_reference,
             };
             render_cmd::bench(&sweep, &cfg, json)?
         }

@@ -248,6 +248,10 @@ pub struct BenchSweep {
     pub size: (u32, u32),
     /// Timed batches per mode.
     pub frames: u32,
+    /// The modes to time (names of [`BENCH_MODES`]); the others print NaN.
+    pub modes: Vec<&'static str>,
+    /// Whether to time the reference march too (else its columns print NaN).
+    pub reference: bool,
 }
 
 /// The modes a bench row times, with their JSON names.
@@ -307,21 +311,26 @@ pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Re
                 let gflat = GpuMaterial::new(r.context(), &flat, scene.camera.target)?;
                 // Every case's batches interleaved: flat, then each mode with the fast and the
                 // reference march.
+                let chosen: Vec<_> = BENCH_MODES
+                    .iter()
+                    .filter(|(n, _)| cfg.modes.contains(n))
+                    .collect();
+                let marches: &[&GpuMaterial] = if cfg.reference { &[&gm, &gref] } else { &[&gm] };
                 let mut cases = vec![(&gflat, ViewMode::Naive)];
-                for g in [&gm, &gref] {
-                    cases.extend(BENCH_MODES.iter().map(|(_, mode)| (g, *mode)));
+                for g in marches {
+                    cases.extend(chosen.iter().map(|(_, mode)| (*g, *mode)));
                 }
                 let ms = frame_ms_interleaved(&r, &mut target, &cases, &scene, cfg.frames);
                 let flat_ms = ms[0];
                 let named = |part: &[f64]| {
-                    BENCH_MODES
+                    chosen
                         .iter()
                         .zip(part)
                         .map(|((n, _), t)| ((*n).to_owned(), *t))
                         .collect()
                 };
-                let frame_ms = named(&ms[1..=BENCH_MODES.len()]);
-                let reference_ms = named(&ms[1 + BENCH_MODES.len()..]);
+                let frame_ms = named(&ms[1..=chosen.len()]);
+                let reference_ms = named(ms.get(1 + chosen.len()..).unwrap_or_default());
                 rows.push(BenchRow {
                     preset: name.clone(),
                     view_deg,
