@@ -277,8 +277,16 @@ gpu_struct! {
         ht_m_max: f32 => "f32",
         /// Table H's largest σ.
         ht_sigma_max: f32 => "f32",
+        /// Offset of the transfer table's slope pyramids (core's `material::table_slope::TableSlope`).
+        ts_offset: u32 => "u32",
+        /// Column intervals per pyramid row, rounded up to a power of two (`TableSlope::p`).
+        ts_p: u32 => "u32",
         /// Padding to WGSL's 16-byte struct size.
         pad1: u32 => "u32",
+        /// Padding to WGSL's 16-byte struct size.
+        pad2: u32 => "u32",
+        /// Padding to WGSL's 16-byte struct size.
+        pad3: u32 => "u32",
     }
 }
 

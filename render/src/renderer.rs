@@ -12,6 +12,7 @@ use glam::{DVec2, DVec3};
 use lodestone_core::driver::field::{DriverField, TiledImage};
 use lodestone_core::driver::noise::SumOfSines;
 use lodestone_core::eval::Evaluator;
+use lodestone_core::eval::compiled::CompiledTransfer;
 use lodestone_core::material::color_terms::CombineMode;
 use lodestone_core::material::colormap::linear_to_srgb;
 use lodestone_core::material::features::{Feature, FeatureSet};
@@ -521,6 +522,15 @@ pub fn material_data_for(
         base.tt_m_min = t.m_min as f32;
         base.tt_m_max = t.m_max as f32;
         base.tt_sigma_max = t.sigma_max as f32;
+    }
+    if let CompiledTransfer::Curve { slopes, .. } = &prepared.transfer
+        && features.contains(Feature::Relief)
+    {
+        let start = data.len();
+        base.ts_offset = data.len() as u32;
+        base.ts_p = slopes.p as u32;
+        data.extend(&slopes.entries);
+        mark(&data, start, "transfer table's slope pyramids");
     }
     let points = m.filtering.slope_points.max(1) as usize;
     if features.contains(Feature::Relief) {

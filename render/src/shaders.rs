@@ -39,6 +39,7 @@ pub const MATERIAL_FILES: &[(&str, &str)] = wgsl_files![
     "microfacet/brdf.wgsl",
     "microfacet/attribute.wgsl",
     "material/preconvolved.wgsl",
+    "material/table_slope.wgsl",
     "material/transfer.wgsl",
     "material/color_terms.wgsl",
     "driver/footprint.wgsl",

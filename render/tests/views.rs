@@ -431,7 +431,11 @@ fn image_driver_views_match_core() {
 
 /// The fast march (octave march, Illinois refinement) and the reference march (global Lipschitz
 /// steps, bisection) render the same images on the GPU: every mode of the default and sponge presets
-/// at a grazing view (78°), and the default preset on a cylinder. The analytic views are identical;
+/// at a grazing view (78°), and the default preset on a cylinder. The analytic views are identical,
+/// except where core's f64 pixel sides with the fast march (at most 0.2% of the pixels: the sponge's
+/// corner pixel (2, 39), whose shadow ray grazes a crest, is lit in core and the fast march since
+/// the level-of-detail march steps by the transfer table's own slopes, and shadowed by the f32
+/// reference);
 /// in the ground truth at most 2% of the pixels differ by more than 1% of the image's peak (where
 /// f32 resolves t to a sizeable fraction of a facet) and the means agree within 0.2%, leaving out
 /// the band of rows next to the horizon (the top 30%) and pixels the reference leaves black and the
@@ -483,7 +487,7 @@ fn fast_and_reference_marches_render_the_same_images() {
                     }
                 }
             }
-            let (mut differ, mut given_up) = (0, 0);
+            let (mut differ, mut given_up, mut reference_off) = (0, 0, 0);
             for y in 0..h {
                 for x in 0..w {
                     let (ca, cb) = (a.rgb(x, y), b.rgb(x, y));
@@ -500,19 +504,38 @@ fn fast_and_reference_marches_render_the_same_images() {
                         }
                         continue;
                     }
-                    if (0..3).any(|c| f64::from((ca[c] - cb[c]).abs()) > 0.01 * peak) {
+                    let off = |a: [f32; 3], b: [f64; 3]| {
+                        (0..3).any(|c| (f64::from(a[c]) - b[c]).abs() > 0.01 * peak)
+                    };
+                    if off(ca, cb.map(f64::from)) {
                         if std::env::var_os("MARCH_DEBUG").is_some() {
                             eprintln!("  ({x}, {y}): fast {ca:?} reference {cb:?}");
                         }
-                        differ += 1;
+                        // An analytic pixel of the plane has core's f64 value to settle it: where
+                        // the fast march agrees with core and the f32 reference march does not
+                        // (a shadow ray grazing a crest), the reference is the one off.
+                        let settled = mode != ViewMode::Truth
+                            && shape == Shape::Plane
+                            && !off(ca, cpu_pixel(&reference, &scene, mode, x, y, w, h))
+                            && off(cb, cpu_pixel(&reference, &scene, mode, x, y, w, h));
+                        if settled {
+                            reference_off += 1;
+                        } else {
+                            differ += 1;
+                        }
                     }
                 }
             }
             let label = format!("{name} {shape:?} {mode:?}");
             eprintln!(
                 "{label}: {differ} of {} pixels differ, {given_up} left out (horizon band, or black in the reference only), \
+                 {reference_off} where the f32 reference march is off core's f64 value and the fast one is not, \
                  means {sa:.4} vs {sb:.4}",
                 w * h
+            );
+            assert!(
+                reference_off as f64 <= 0.002 * f64::from(w * h),
+                "{label}: the reference march is off core at {reference_off} pixels"
             );
             assert!(
                 given_up as f64 <= 0.35 * f64::from(w * h),

@@ -6,6 +6,7 @@ use crate::driver::histogram::{DriverHistogram, MU_RANGE, SIGMA_G_MAX};
 use crate::eval::query::FootprintStats;
 use crate::material::colormap::Gradient;
 use crate::material::preconvolved::{PreconvolvedTable, TableSpec};
+use crate::material::table_slope::TableSlope;
 use crate::material::transfer::{TransferFunction, TransferMoments};
 use crate::material::{ColorModel, ColorSource};
 use crate::math::special::erf;
@@ -172,6 +173,8 @@ pub enum CompiledTransfer {
     Curve {
         /// The table.
         table: PreconvolvedTable,
+        /// Its mean channel's slope bounds, for the level-of-detail march.
+        slopes: TableSlope,
     },
 }
 
@@ -179,7 +182,10 @@ impl CompiledTransfer {
     /// Compile a transfer function, building a curve's table at `spec`.
     pub fn new(transfer: &TransferFunction, spec: TableSpec) -> Self {
         match transfer.preconvolve(spec) {
-            Some(table) => Self::Curve { table },
+            Some(table) => Self::Curve {
+                slopes: TableSlope::new(&table),
+                table,
+            },
             None => Self::Identity,
         }
     }
@@ -187,7 +193,7 @@ impl CompiledTransfer {
     /// The pre-convolved table (curves only).
     pub fn table(&self) -> Option<&PreconvolvedTable> {
         match self {
-            Self::Curve { table } => Some(table),
+            Self::Curve { table, .. } => Some(table),
             Self::Identity => None,
         }
     }
@@ -196,7 +202,7 @@ impl CompiledTransfer {
     /// table's bilinear lookup for a curve.
     pub fn moments(&self, m: f64, s: f64) -> TransferMoments {
         match self {
-            Self::Curve { table } => {
+            Self::Curve { table, .. } => {
                 let v = table.sample(m, s);
                 TransferMoments {
                     mean: v[0],

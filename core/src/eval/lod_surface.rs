@@ -42,10 +42,12 @@ impl Evaluator {
             if let Some(mut os) = s.octaves(Some(&att)) {
                 // σ_f is the phase average, the same at every x.
                 let sf = s.driver.lod_moments(DVec2::new(o.x, o.y), fp).1;
-                if let (Some(poly), CompiledTransfer::Curve { table }) =
-                    (&s.transfer_poly, &self.transfer)
-                {
-                    os.g_slope = Some(LocalSlope::level_of_detail(poly, table, sf, s.g_lip));
+                if let CompiledTransfer::Curve { table, slopes } = &self.transfer {
+                    // G is the table's row at σ_f: its own slopes bound the march, locally and
+                    // globally (the curve's max |g′| is the riser's, several times steeper).
+                    let rows = slopes.at(table, sf);
+                    os.g_lip = os.g_lip.min(rows.max());
+                    os.g_slope = Some(LocalSlope::Table(rows));
                 }
                 let total = n.waves.iter().map(|w| w.amplitude.abs()).sum();
                 let shift = n

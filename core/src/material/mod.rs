@@ -19,6 +19,7 @@ pub mod environment;
 pub mod features;
 pub mod preconvolved;
 pub mod slope_color;
+pub mod table_slope;
 pub mod transfer;
 pub mod validation;
 

@@ -136,6 +136,13 @@ impl PreconvolvedTable {
         out
     }
 
+    /// The two rows [`PreconvolvedTable::sample`] blends at σ (equal past the last row).
+    pub fn sigma_rows(&self, sigma: f64) -> (usize, usize) {
+        let fv = sigma / self.sigma_max * (self.size_sigma - 1) as f64;
+        let (j0, j1, _) = split(fv, self.size_sigma);
+        (j0, j1)
+    }
+
     /// Bytes the table occupies as RGBA32F.
     pub fn bytes(&self) -> usize {
         self.texels.len() * 16

@@ -22,7 +22,9 @@
 //! the far field costs a step or two by construction.
 //!
 //! For a transfer curve, `g_lip` is the steepest riser's slope, far above g′ on the curve's flats.
-//! [`LocalSlope`] bounds |g′| over an interval of f exactly (g′ is piecewise quadratic); along a trial
+//! [`LocalSlope`] bounds |G′| over an interval of f exactly (on the explicit surface g′ is piecewise
+//! quadratic; on the level-of-detail surface G is the transfer table's row at σ_f, piecewise linear,
+//! and its global bound, the row's steepest slope, replaces `g_lip` there); along a trial
 //! step of length s the level's f stays within `f_l ± (R_l + K_l s)`, so both bounds hold there with
 //! that local constant, and the step they give is safe as long as it does not outrun its trial
 //! ([`OctaveSurface::local_step`]).

@@ -219,11 +219,7 @@ impl Surface {
             },
             h_max: self.h_max,
             min_step: self.min_step,
-            g_slope: self.transfer_poly.as_ref().map(|poly| LocalSlope {
-                poly,
-                widen: 0.0,
-                tail: 0.0,
-            }),
+            g_slope: self.transfer_poly.as_ref().map(LocalSlope::Curve),
             grid: self.grid.as_ref().map(GridView::explicit),
             field: self.field.as_ref().map(FieldView::explicit),
         })

@@ -50,7 +50,16 @@ fn lod_prepare(fp: vec3<f32>) -> f32 {
         }
     }
 //#endif
-    return sqrt(max(v, 0.0));
+    let sf = sqrt(max(v, 0.0));
+//#if noise
+//#if transfer_curve
+    if (params.transfer_kind != TRANSFER_IDENTITY) {
+        lod_rows = table_slope_at(sf);
+        lod_g_lip = min(params.g_lip, table_slope_max(lod_rows));
+    }
+//#endif
+//#endif
+    return sf;
 }
 
 //#endif

@@ -3,21 +3,29 @@
 
 //#if relief
 //#if noise
-// LocalSlope::lipschitz_on (with LocalSlope::level_of_detail's widening when lod): a bound of |G′|
-// over [lo, hi] for a transfer curve, at most g_lip; g_lip for the identity.
+// LocalSlope::lipschitz_on: a bound of |G′| over [lo, hi] for a transfer curve, at most the march's
+// global bound (march_g_lip); g_lip for the identity. On the explicit surface the curve's |g′|
+// (LocalSlope::Curve); on the level-of-detail surface the slopes of the transfer table's rows at
+// the footprint's σ_f (LocalSlope::Table, rows set by lod_prepare).
 fn lipschitz_on(lo: f32, hi: f32, lod: bool, sf: f32) -> f32 {
 //#if transfer_curve
     if (params.transfer_kind != TRANSFER_IDENTITY) {
-        var widen = 0.0;
-        var tail = 0.0;
         if (lod) {
-            let dm = (params.tt_m_max - params.tt_m_min) / f32(max(params.tt_size_m, 2u) - 1u);
-            let ds = params.tt_sigma_max / f32(max(params.tt_size_s, 2u) - 1u);
-            widen = 6.0 * (sf + ds) + dm;
-            tail = 2e-9 * params.g_lip;
+            return min(table_slope_on(lod_rows, lo, hi), lod_g_lip);
         }
-        let g = poly_max_abs_on(params.tp_offset, params.tp_knots, 2u, 1u, lo - widen, hi + widen);
-        return min(g * (1.0 + 1e-5) + tail, params.g_lip);
+        let g = poly_max_abs_on(params.tp_offset, params.tp_knots, 2u, 1u, lo, hi);
+        return min(g * (1.0 + 1e-5), params.g_lip);
+    }
+//#endif
+    return params.g_lip;
+}
+
+// The global bound of |G′| the octave march uses (Evaluator::lod_march's `os.g_lip`): g_lip, or on
+// the level-of-detail surface of a transfer curve the largest slope of the table's rows at σ_f.
+fn march_g_lip(lod: bool) -> f32 {
+//#if transfer_curve
+    if (lod && params.transfer_kind != TRANSFER_IDENTITY) {
+        return lod_g_lip;
     }
 //#endif
     return params.g_lip;

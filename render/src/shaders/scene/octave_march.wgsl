@@ -175,7 +175,7 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
     let levels = clamp(params.level_count, 1u, 4u);
     let last = levels - 1u;
     let rw = octave_ray(d, lod);
-    let sg = params.sigma_h * params.g_lip;
+    let sg = params.sigma_h * march_g_lip(lod);
     // The slab: |h| ≤ h_max and |G(f)| ≤ |G(0)| + g_lip Σ|a_i| (thin in the far field).
     let top = min(params.h_max, abs(octave_height(0.0, lod, sf)) + sg * rw.total) * (1.0 + 1e-6) + 1e-30;
     // The f32 guard of march_heightfield.
