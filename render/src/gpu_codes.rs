@@ -5,6 +5,7 @@
 //! factor and the march's over-relaxation come from `lodestone-core`, so each has one definition.
 
 use crate::gpu_types::{GpuStruct, MaterialParams};
+use lodestone_core::eval::lod_surface::LOD_SETTLE;
 use lodestone_core::microfacet::effective_height::{
     FIT_ALPHA_MU, FIT_ALPHA_SIGMA, FIT_BETA_MU, FIT_BETA_SIGMA,
 };
@@ -174,6 +175,7 @@ pub fn wgsl_prelude() -> &'static str {
             ("FAST_WIDTH", FAST_WIDTH_F32),
             ("GRID_MARGIN", GRID_MARGIN_F32),
             ("FIELD_SETTLE", FIELD_SETTLE),
+            ("LOD_SETTLE", LOD_SETTLE),
         ];
         for (name, v) in floats {
             let _ = writeln!(s, "const {name}: f32 = {:?};", v as f32);

@@ -24,6 +24,19 @@ impl Footprint {
     pub fn point() -> Self {
         Self::isotropic(0.0)
     }
+
+    /// The smallest standard deviation along any direction: the square root of Σ_p's smaller
+    /// eigenvalue `(a + b)/2 − √(((a − b)/2)² + c²)`; 0 for a degenerate, non-finite or
+    /// non-positive covariance.
+    pub fn min_std(&self) -> f64 {
+        let (a, b, c) = (self.cov.x_axis.x, self.cov.y_axis.y, self.cov.x_axis.y);
+        let l = 0.5 * (a + b) - (0.25 * (a - b) * (a - b) + c * c).sqrt();
+        if l > 0.0 && l.is_finite() {
+            l.sqrt()
+        } else {
+            0.0
+        }
+    }
 }
 
 /// Driver statistics over a footprint.

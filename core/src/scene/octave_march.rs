@@ -39,7 +39,11 @@
 //! A ray that starts clear of the surface (gap > 1000 ε at t = 0: a camera ray) stops as soon as the
 //! exact gap is within `ε = HIT_GAP·top` of it, on the surface to within shading precision, instead of
 //! stepping across and refining the bracket (a third of the work at 30–60°). A ray that leaves the
-//! surface (a shadow ray) must cross it to be stopped, so it never shadows itself.
+//! surface (a shadow ray) must cross it to be stopped, so it never shadows itself. With a
+//! `settle_width` (the level-of-detail surface, identity transfer), a camera ray also stops at the
+//! low end of the first crossing's bracket once the bracket is that narrow
+//! ([`OctaveSurface::bracket_width`]): on the default preset's 96×64 frames, 28–30% fewer waves
+//! summed per camera ray at a thousandth of the footprint.
 //!
 //! Either bound stays positive up to its first root, so the step is the larger of the two roots,
 //! over every level evaluated at the point (a coarse level sees far, the last one sees close). The
@@ -97,6 +101,11 @@ pub struct OctaveSurface<'a> {
     /// f read from a table with error bounds, to step and settle on near the surface without
     /// summing the waves ([`crate::scene::field_grid`]).
     pub field: Option<FieldView<'a>>,
+    /// A camera ray may stop at the low end of the first crossing's bracket once the bracket is
+    /// at most this long ([`OctaveSurface::bracket_width`]; the identity transfer only); 0: it
+    /// stops only on the surface. The level-of-detail march sets it from the footprint
+    /// ([`crate::eval::lod_surface`]); the explicit surface keeps 0.
+    pub settle_width: f64,
 }
 
 /// Most grid lookups per [`OctaveSurface::grid_skip`].
@@ -282,6 +291,14 @@ impl OctaveSurface<'_> {
                 }
                 if l == last
                     && t > 0.0
+                    && may_settle == Some(true)
+                    && let Some((lo, width)) = self.bracket_width(gap, fd, rw.curv[l], d.z)
+                    && width <= self.settle_width
+                {
+                    return Some(t + lo);
+                }
+                if l == last
+                    && t > 0.0
                     && let Some(hit) = self.converge(&exact, t, gap, fd, rw.curv[l], d.z)
                 {
                     return Some(hit);
@@ -365,6 +382,36 @@ impl OctaveSurface<'_> {
             f64::INFINITY
         };
         first.max(second)
+    }
+
+    /// The first crossing's bracket ahead of a point at exact gap `γ = gap > 0` of a linear G (the
+    /// identity): `(s_lo, s_hi − s_lo)`. With the gap's descent rate `β = σ_h f′ − d_z > 0` and
+    /// `|γ″| ≤ 2c` (`c = σ_h M/2`, M the ray's curvature bound `curv`), `γ − βs − cs² ≤ γ(t + s) ≤
+    /// γ − βs + cs²`: the lower bound stays positive up to `s_lo = 2γ/(β + √(β² + 4cγ))` (the safe
+    /// step), and when `β² ≥ 4cγ` the upper bound reaches 0 at `s_hi = 2γ/(β + √(β² − 4cγ))`, so
+    /// the first crossing lies in `(t + s_lo, t + s_hi]`. The width is written without the
+    /// difference of the roots, `8cγ²·2/((√D₊ + √D₋)(β + √D₋)(β + √D₊))`, so f32 keeps it to
+    /// relative rounding. `None` when G is not linear or the conditions do not hold.
+    pub(crate) fn bracket_width(
+        &self,
+        gap: f64,
+        fd: f64,
+        curv: f64,
+        dz: f64,
+    ) -> Option<(f64, f64)> {
+        if !self.linear || !(gap > 0.0) {
+            return None;
+        }
+        let beta = self.sigma_h * fd - dz;
+        let c = 0.5 * self.sigma_h * curv;
+        let (dp, dm) = (beta * beta + 4.0 * c * gap, beta * beta - 4.0 * c * gap);
+        if !(beta > 0.0 && dm >= 0.0) {
+            return None;
+        }
+        let (rp, rm) = (dp.sqrt(), dm.sqrt());
+        let lo = 2.0 * gap / (beta + rp);
+        let width = 16.0 * c * gap * gap / ((rp + rm) * (beta + rm) * (beta + rp));
+        Some((lo, width))
     }
 
     /// Near a transversal crossing of a linear G (the identity), the first crossing directly: with
@@ -473,6 +520,7 @@ mod tests {
     use crate::driver::footprint::Footprint;
     use crate::driver::noise::NoiseParams;
     use crate::eval::Evaluator;
+    use crate::eval::lod_surface::LOD_SETTLE;
     use crate::material::transfer::{Curve, TransferFunction};
     use crate::material::{Driver, Heights, Material, Slopes};
     use crate::math::random::splitmix;
@@ -629,7 +677,8 @@ mod tests {
 
     /// The level-of-detail surface (attenuated waves, the transfer function's footprint mean) from
     /// a point footprint to one that blurs two octaves, and the far field where every wave is gone
-    /// (the thin slab): the octave march meets h̄ where the reference march does.
+    /// (the thin slab): the octave march meets h̄ where the reference march does, or (a camera
+    /// ray of the identity transfer) up to the settle width before it, never past it.
     #[test]
     fn the_octave_march_finds_the_reference_crossing_on_the_level_of_detail_surface() {
         let mut rng = 17u64;
@@ -641,7 +690,7 @@ mod tests {
                 fast.surface = with_grid(fast.surface.clone());
             }
             let scale = fast.surface.driver.finest_scale();
-            let mut differ = 0;
+            let (mut differ, mut early) = (0, 0);
             for i in 0..240 {
                 let fp = Footprint::isotropic(scale * [0.0, 0.05, 0.2, 0.5, 1.0, 3.0, 30.0][i % 7]);
                 let theta = (30.0 + 58.0 * splitmix(&mut rng)).to_radians();
@@ -655,16 +704,33 @@ mod tests {
                 let (Some(a), Some(b)) = (a, b) else {
                     panic!("{}: downward rays hit h̄: {a:?} {b:?}", m.name)
                 };
-                if (a - b).abs() > 1e-9 * b.max(1.0) {
+                // Never past the reference's crossing; before it by at most the settle width,
+                // and only for camera rays of the identity transfer (the bracket's low end).
+                let width = LOD_SETTLE * fp.min_std();
+                assert!(a <= b + 1e-9 * b.max(1.0), "{}: {a} past {b}", m.name);
+                if (a - b).abs() > 1e-9 * b.max(1.0) + width * (1.0 + 1e-9) {
                     differ += 1;
+                } else if a < b - 1e-9 * b.max(1.0) {
+                    early += 1;
                 }
                 let p = o + d * a;
                 let gap = p.z - fast.lod_height(DVec2::new(p.x, p.y), fp);
-                assert!(gap.abs() < 1e-9, "{}: off h̄ by {gap}", m.name);
+                assert!(
+                    gap > -1e-9 && gap < 1e-9 + width * (d.z.abs() + fast.surface.slope_bound()),
+                    "{}: off h̄ by {gap}",
+                    m.name
+                );
             }
             assert!(
                 differ <= 1,
                 "{} (grid {grid}): {differ} of 240 rays differ",
+                m.name
+            );
+            // The bracket settles camera rays of the identity transfer (the new path is taken).
+            let linear = matches!(m.heights.transfer, TransferFunction::Identity);
+            assert!(
+                !linear || early > 10,
+                "{}: {early} rays settled early",
                 m.name
             );
         }

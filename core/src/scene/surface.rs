@@ -222,6 +222,7 @@ impl Surface {
             g_slope: self.transfer_poly.as_ref().map(LocalSlope::Curve),
             grid: self.grid.as_ref().map(GridView::explicit),
             field: self.field.as_ref().map(FieldView::explicit),
+            settle_width: 0.0,
         })
     }
 

@@ -13,6 +13,9 @@ var<private> lod_count: u32;
 // The footprint's 6σ per axis, by which the octave march dilates the bound grid's boxes
 // (GridView::level_of_detail). Set by lod_prepare.
 var<private> lod_dilate: vec2<f32>;
+// How narrow the first crossing's bracket must be for a camera ray to stop at its low end
+// (OctaveSurface::settle_width = LOD_SETTLE × the footprint's smallest deviation). Set by lod_prepare.
+var<private> lod_settle: f32;
 
 //#endif
 //#endif
@@ -38,6 +41,7 @@ fn lod_prepare(fp: vec3<f32>) -> f32 {
     var v = 0.0;
 //#if noise
     lod_dilate = 6.0 * sqrt(max(fp.xy, vec2<f32>(0.0)));
+    lod_settle = LOD_SETTLE * footprint_min_std(fp);
     lod_count = 0u;
     for (var i = 0u; i < params.wave_count; i = i + 1u) {
         let w = cached_wave(i);

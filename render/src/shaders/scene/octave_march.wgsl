@@ -169,6 +169,26 @@ fn octave_local_step(found_in: vec3<f32>, above: f32, f: f32, fd: f32, lip: f32,
     return found;
 }
 
+// OctaveSurface::bracket_width: (s_lo, width) of the first crossing's bracket ahead of exact gap
+// `gap` for the identity transfer; width −1 when the conditions do not hold.
+fn octave_bracket_width(gap: f32, fd: f32, curv: f32, dz: f32) -> vec2<f32> {
+    if (params.transfer_kind != TRANSFER_IDENTITY || !(gap > 0.0)) {
+        return vec2<f32>(0.0, -1.0);
+    }
+    let beta = params.sigma_h * fd - dz;
+    let c = 0.5 * params.sigma_h * curv;
+    let dp = beta * beta + 4.0 * c * gap;
+    let dm = beta * beta - 4.0 * c * gap;
+    if (!(beta > 0.0 && dm >= 0.0)) {
+        return vec2<f32>(0.0, -1.0);
+    }
+    let rp = sqrt(dp);
+    let rm = sqrt(dm);
+    let lo = 2.0 * gap / (beta + rp);
+    let width = 16.0 * c * gap * gap / ((rp + rm) * (beta + rm) * (beta + rp));
+    return vec2<f32>(lo, width);
+}
+
 // OctaveSurface::march on the explicit (lod = false) or level-of-detail surface (lod = true, after
 // lod_prepare, whose σ_f is sf): t of the first crossing, or -1 when the ray leaves the slab.
 fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
@@ -240,6 +260,12 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
             var gap = above - sg * rw.resid[l];
             if (l == last && t > 0.0 && gap >= 0.0 && gap <= settle && may_settle == 1u) {
                 return t;
+            }
+            if (lod && l == last && t > 0.0 && may_settle == 1u) {
+                let br = octave_bracket_width(gap, acc.y, rw.curv[l], d.z);
+                if (br.y >= 0.0 && br.y <= lod_settle) {
+                    return t + br.x;
+                }
             }
             if (l == last && gap < 0.0) {
                 if (t > 0.0) {
