@@ -97,7 +97,7 @@ const MIRRORS: &[(&str, &str, &str, &str)] = &[
     ("scene/octave_march.wgsl", "octave_partial", "scene/octave_march.rs", "march"),
     ("scene/octave_march.wgsl", "octave_height", "scene/octave_march.rs", "march"),
     ("scene/octave_march.wgsl", "octave_step", "scene/octave_march.rs", "step"),
-    ("scene/octave_march.wgsl", "octave_bracket_width", "scene/octave_march.rs", "bracket_width"),
+    ("scene/octave_march.wgsl", "octave_bracket_width", "scene/crossing.rs", "bracket_width"),
     ("scene/grid_skip.wgsl", "octave_grid_gap", "scene/grid_skip.rs", "grid_gap"),
     ("scene/grid_skip.wgsl", "octave_grid_skip", "scene/grid_skip.rs", "grid_skip"),
     ("scene/field_grid.wgsl", "field_sample", "scene/field_grid.rs", "sample"),

@@ -4,6 +4,7 @@
 
 pub mod bound_grid;
 pub mod camera;
+pub mod crossing;
 pub mod cylinder;
 pub mod direction;
 pub mod field_grid;
