@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # Regenerate screenshots/views/: every mode and error map of three presets at a near-grazing view.
-# Usage: bash scripts/screenshots.sh   (uses the release build; ~10 minutes on llvmpipe, seconds on a GPU)
+# Usage: bash scripts/screenshots.sh   (uses the release build; ~40 minutes on llvmpipe with 2 cores (13 per preset), seconds on a GPU)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release -q
 for preset in default moss dirt-in-crevices; do
     ./target/release/lodestone --preset "presets/$preset.ron" render --mode all --formats png \
-        --view-deg 70 --light-deg 50 --light-azimuth-deg 120 --distance 8 --size 480x270 --spp 1024 \
+        --view-deg 70 --light-deg 50 --light-azimuth-deg 120 --distance 8 --size 480x270 --spp 256 \
         --out "screenshots/views/$preset" | tee "screenshots/views/$preset.txt"
 done
 # The curved object (default preset on a cylinder, seen side-on).
