@@ -11,7 +11,7 @@ fn lipschitz_on(lo: f32, hi: f32, lod: bool, sf: f32) -> f32 {
 //#if transfer_curve
     if (params.transfer_kind != TRANSFER_IDENTITY) {
         if (lod) {
-            return min(table_slope_on(lod_rows, lo, hi), lod_g_lip);
+            return min(table_slope_on(lod_rows, lo, hi) * (1.0 + 1e-5), lod_g_lip);
         }
         let g = poly_max_abs_on(params.tp_offset, params.tp_knots, 2u, 1u, lo, hi);
         return min(g * (1.0 + 1e-5), params.g_lip);
