@@ -21,6 +21,7 @@
 //! `2^k` intervals of level 0) starts at `2P − (2P >> k)`. Entries are rounded up to f32.
 
 use crate::material::preconvolved::PreconvolvedTable;
+use crate::math::rounding::f32_up;
 
 /// Per-row max-pyramids of a pre-convolved table's mean-channel slope (module docs).
 #[derive(Clone, Debug, PartialEq)]
@@ -39,12 +40,6 @@ pub struct TableSlope {
     pub intervals: usize,
 }
 
-/// The next f32 at or above `x`.
-fn up(x: f64) -> f32 {
-    let f = x as f32;
-    if f64::from(f) < x { f.next_up() } else { f }
-}
-
 impl TableSlope {
     /// The pyramids of `table`'s channel 0.
     pub fn new(table: &PreconvolvedTable) -> Self {
@@ -58,7 +53,7 @@ impl TableSlope {
             let t = &table.texels[j * table.size_m..(j + 1) * table.size_m];
             for i in 0..intervals.min(t.len().saturating_sub(1)) {
                 let d = (f64::from(t[i + 1][0]) - f64::from(t[i][0])).abs() / dm;
-                row[i] = if d.is_finite() { up(d) } else { f32::MAX };
+                row[i] = if d.is_finite() { f32_up(d) } else { f32::MAX };
             }
             let (mut from, mut n) = (0, p);
             while n > 1 {

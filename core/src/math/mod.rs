@@ -7,6 +7,7 @@ pub mod gaussian;
 pub mod piecewise;
 pub mod quadrature;
 pub mod random;
+pub mod rounding;
 pub mod sh;
 pub mod special;
 pub mod special_f32;

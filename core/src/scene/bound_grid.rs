@@ -19,6 +19,7 @@
 
 use crate::driver::footprint::Footprint;
 use crate::driver::noise::SumOfSines;
+use crate::math::rounding::{f32_down, f32_up};
 use glam::DVec2;
 use rayon::prelude::*;
 use std::f64::consts::TAU;
@@ -57,18 +58,6 @@ fn curvature_bound(noise: &SumOfSines) -> f64 {
         .iter()
         .map(|w| w.amplitude.abs() * (TAU * w.k.length()).powi(2))
         .sum()
-}
-
-/// The next f32 at or below `x`.
-fn down(x: f64) -> f32 {
-    let f = x as f32;
-    if f64::from(f) > x { f.next_down() } else { f }
-}
-
-/// The next f32 at or above `x`.
-fn up(x: f64) -> f32 {
-    let f = x as f32;
-    if f64::from(f) < x { f.next_up() } else { f }
 }
 
 impl BoundGrid {
@@ -144,7 +133,7 @@ impl BoundGrid {
                 let hi = c.iter().copied().fold(f64::NEG_INFINITY, f64::max);
                 // Rounding of the sums: a few ulps of Σ|a_i|.
                 let eps = 1e-12 * (1.0 + hi.abs().max(lo.abs()));
-                [down(lo - slack - eps), up(hi + slack + eps)]
+                [f32_down(lo - slack - eps), f32_up(hi + slack + eps)]
             })
             .collect();
         // Coarser levels: the min and max of 2×2 cells of the level below.
