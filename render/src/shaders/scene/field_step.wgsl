@@ -13,7 +13,7 @@ fn octave_field_step(p: vec3<f32>, d: vec3<f32>, lip: f32, curv: f32, lod: bool,
         return vec3<f32>(0.0);
     }
     let e = pr.y;
-    let g = min(lipschitz_on(pr.x - e, pr.x + e, lod, sf), params.g_lip);
+    let g = min(lipschitz_on(pr.x - e, pr.x + e, lod), params.g_lip);
     let above = p.z - octave_height(pr.x, lod, sf);
     let band = params.sigma_h * g * e;
     let lo = above - band;
@@ -53,7 +53,7 @@ fn octave_field_crossing_ahead(p: vec3<f32>, d: vec3<f32>, pr: vec4<f32>, reach:
     if (pq.y < 0.0) {
         return vec3<f32>(0.0);
     }
-    let g = min(lipschitz_on(pq.x - pq.y, pq.x + pq.y, lod, sf), params.g_lip);
+    let g = min(lipschitz_on(pq.x - pq.y, pq.x + pq.y, lod), params.g_lip);
     if (q.z - octave_height(pq.x, lod, sf) + params.sigma_h * g * pq.y < 0.0) {
         return vec3<f32>(1.0, 0.0, 0.0);
     }

@@ -23,7 +23,7 @@ fn octave_grid_gap(a: vec3<f32>, b: vec3<f32>, lod: bool, sf: f32) -> vec2<f32> 
     if (params.transfer_monotone == 2u) {
         h = octave_height(r.x, lod, sf);
     } else if (params.transfer_monotone == 0u) {
-        let l = lipschitz_on(r.x, r.y, lod, sf);
+        let l = lipschitz_on(r.x, r.y, lod);
         h = octave_height(0.5 * (r.x + r.y), lod, sf) + params.sigma_h * l * 0.5 * (r.y - r.x);
     }
     return vec2<f32>(min(a.z, b.z) - h, 1.0);

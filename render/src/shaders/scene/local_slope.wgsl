@@ -7,7 +7,7 @@
 // global bound (march_g_lip); g_lip for the identity. On the explicit surface the curve's |g′|
 // (LocalSlope::Curve); on the level-of-detail surface the slopes of the transfer table's rows at
 // the footprint's σ_f (LocalSlope::Table, rows set by lod_prepare).
-fn lipschitz_on(lo: f32, hi: f32, lod: bool, sf: f32) -> f32 {
+fn lipschitz_on(lo: f32, hi: f32, lod: bool) -> f32 {
 //#if transfer_curve
     if (params.transfer_kind != TRANSFER_IDENTITY) {
         if (lod) {

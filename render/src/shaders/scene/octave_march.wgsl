@@ -148,7 +148,7 @@ fn octave_local_step(found_in: vec3<f32>, above: f32, f: f32, fd: f32, lip: f32,
     var trial = 8.0 * max(select(0.0, found.x, found.z > 0.0), min_step);
     for (var i = 0u; i < 4u; i = i + 1u) {
         let reach = resid + lip * trial;
-        let sg = params.sigma_h * lipschitz_on(f - reach, f + reach, lod, sf);
+        let sg = params.sigma_h * lipschitz_on(f - reach, f + reach, lod);
         let gap = above - sg * resid;
         if (!(gap >= 0.0)) {
             break;
