@@ -94,9 +94,16 @@ impl Evaluator {
         // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
         let mean = loc.stats.slope_mean;
         let shading = self.visible_shading(mean, &sigma, cfg.wo, cfg.wi, frame);
-        let spec = filtered_specular(brdf.specular, brdf.roughness, mean, &sigma, cfg.wo, cfg.wi)
-            * self.lobe_density_ratio(cfg, mean);
-        self.radiance(sun_color, env_color, &shading, sun_visible * vbar, spec)
+        let lit = sun_visible * vbar;
+        let mut spec =
+            filtered_specular(brdf.specular, brdf.roughness, mean, &sigma, cfg.wo, cfg.wi);
+        // The density ratio scales only the sun's specular term: where the sun does not reach the
+        // pixel (shadowed, behind the mean plane, or no sun) or the lobe is 0, it changes nothing,
+        // and its saddle point is the costliest part of the pixel (issue #15).
+        if spec > 0.0 && lit > 0.0 && self.material.lighting.sun != 0.0 {
+            spec *= self.lobe_density_ratio(cfg, mean);
+        }
+        self.radiance(sun_color, env_color, &shading, lit, spec)
     }
 }
 

@@ -41,8 +41,13 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
     // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
     let s_mean = loc.stats.slope_mean;
     let shading = visible_shading(s_mean, cov, wo_w, wi_w);
-    let spec = filtered_specular(s_mean, cov, wo_w, wi_w) * lobe_density_ratio(fp, s_mean, wo_w, wi_w);
-    return radiance(sun_color, env_color, shading, sun_visible * vbar, spec);
+    let lit = sun_visible * vbar;
+    var spec = filtered_specular(s_mean, cov, wo_w, wi_w);
+    // The density ratio scales only the sun's specular term: skipped where it changes nothing.
+    if (spec > 0.0 && lit > 0.0 && params.sun != 0.0) {
+        spec = spec * lobe_density_ratio(fp, s_mean, wo_w, wi_w);
+    }
+    return radiance(sun_color, env_color, shading, lit, spec);
 //#else
     // Flat: every facet faces +z, nothing masks or shadows (Λ = 0, and D_h at L = 0 is the
     // identity, so the colour is that of the footprint's own distribution).
