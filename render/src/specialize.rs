@@ -341,9 +341,10 @@ mod tests {
                     .normalized()
             })
             .collect();
-        for s in sets {
+        use rayon::prelude::*;
+        sets.into_par_iter().for_each(|s| {
             ShaderSize::measure(&view_source_for(s).expect("source"), "view_main")
                 .unwrap_or_else(|e| panic!("{s}: {e}"));
-        }
+        });
     }
 }

@@ -3,13 +3,14 @@
 
 //#if relief
 //#if noise
-// OctaveSurface::ray's per-ray level bounds: residual amplitude R, first-order K and curvature M per
-// level (at most MAX_LEVELS = 4).
+// OctaveSurface::ray's per-ray level bounds: residual amplitude R, first-order K, curvature M and
+// third-order J per level (at most MAX_LEVELS = 4).
 struct OctaveRay {
     total: f32,
     resid: vec4<f32>,
     lip: vec4<f32>,
     curv: vec4<f32>,
+    jerk: vec4<f32>,
 }
 
 // Wave i's amplitude on the explicit surface, or times its footprint attenuation (lod_prepare) on
@@ -51,6 +52,7 @@ fn octave_ray(d: vec3<f32>, lod: bool) -> OctaveRay {
     r.total = total;
     var k = 0.0;
     var m = 0.0;
+    var jk = 0.0;
     var below = 0.0;
     var start = 0u;
     for (var l = 0u; l < min(params.level_count, 4u); l = l + 1u) {
@@ -60,11 +62,13 @@ fn octave_ray(d: vec3<f32>, lod: bool) -> OctaveRay {
             let om = TAU * dot(cached_wave(i).xy, d.xy);
             k = k + a * abs(om);
             m = m + a * om * om;
+            jk = jk + a * abs(om * om * om);
             below = below + a;
         }
         start = e;
         r.lip[l] = k;
         r.curv[l] = m;
+        r.jerk[l] = jk;
         if (e < n) {
             r.resid[l] = max(total - below, 0.0);
         }
@@ -72,17 +76,19 @@ fn octave_ray(d: vec3<f32>, lod: bool) -> OctaveRay {
     return r;
 }
 
-// Wave i's (value, slope along dxy) at x, for OctaveSurface::march's partial sums.
-fn octave_term(i: u32, x: vec2<f32>, dxy: vec2<f32>, lod: bool) -> vec2<f32> {
+// Wave i's (value, slope, second derivative along dxy) at x, for OctaveSurface::march's partial sums.
+fn octave_term(i: u32, x: vec2<f32>, dxy: vec2<f32>, lod: bool) -> vec3<f32> {
     let w = cached_wave(i);
     let a = octave_amplitude(i, lod);
     let ph = TAU * dot(w.xy, x) + w.w;
-    return vec2<f32>(a * cos(ph), -a * TAU * dot(w.xy, dxy) * sin(ph));
+    let om = TAU * dot(w.xy, dxy);
+    let c = a * cos(ph);
+    return vec3<f32>(c, -a * om * sin(ph), -om * om * c);
 }
 
-// (f, f′ along dxy) over waves [first, end) at x. Eight waves per iteration: see UNROLL.
-fn octave_partial(first: u32, end: u32, x: vec2<f32>, dxy: vec2<f32>, lod: bool) -> vec2<f32> {
-    var acc = vec2<f32>(0.0);
+// (f, f′, f″ along dxy) over waves [first, end) at x. Eight waves per iteration: see UNROLL.
+fn octave_partial(first: u32, end: u32, x: vec2<f32>, dxy: vec2<f32>, lod: bool) -> vec3<f32> {
+    var acc = vec3<f32>(0.0);
     var i = first;
     if (end > first) {
         let n8 = first + ((end - first) & ~7u);
@@ -189,6 +195,86 @@ fn octave_bracket_width(gap: f32, fd: f32, curv: f32, dz: f32) -> vec2<f32> {
     return vec2<f32>(lo, width);
 }
 
+// crossing::first_root: the first positive root of γ − βs − cs², 1e30 when it stays positive.
+fn first_root(gap: f32, beta: f32, c: f32) -> f32 {
+    let disc = beta * beta + 4.0 * c * gap;
+    if (!(disc >= 0.0)) {
+        return 1e30;
+    }
+    let den = beta + sqrt(disc);
+    if (den > 0.0) {
+        return 2.0 * gap / den;
+    }
+    if (gap == 0.0 && c > 0.0) {
+        return 0.0;
+    }
+    return 1e30;
+}
+
+// GPU only: f″ summed in f32 is off by at most about this fraction of the level's M (a few ulps per
+// term over at most 256 terms); the third-order bounds widen q by it.
+const CUBIC_MARGIN: f32 = 1e-4;
+
+// OctaveSurface::cubic_step: the safe step from the gap's third-order bound (identity transfer),
+// windows 2·safe (a step already proven safe) then each step found; 0 when it does not apply.
+fn octave_cubic_step(gap: f32, fd: f32, fdd: f32, jerk: f32, curv: f32, dz: f32, safe: f32, min_step: f32) -> f32 {
+    if (params.transfer_kind != TRANSFER_IDENTITY || !(gap > 0.0)) {
+        return 0.0;
+    }
+    let beta = params.sigma_h * fd - dz;
+    let q = 0.5 * params.sigma_h * (fdd + CUBIC_MARGIN * curv);
+    let r = params.sigma_h * jerk / 6.0;
+    var window = 2.0 * max(safe, min_step);
+    var best = 0.0;
+    for (var k = 0u; k < 3u; k = k + 1u) {
+        let s = first_root(gap, beta, q + r * window);
+        best = max(best, min(s, window));
+        if (!(s < 1e30 && s > 0.0)) {
+            break;
+        }
+        window = s;
+    }
+    return best;
+}
+
+// OctaveSurface::cubic_bracket: (s_lo, width) of the first crossing's bracket from the gap's
+// third-order bounds; width −1 when the conditions do not hold.
+fn octave_cubic_bracket(gap: f32, fd: f32, fdd: f32, jerk: f32, curv: f32, dz: f32) -> vec2<f32> {
+    if (params.transfer_kind != TRANSFER_IDENTITY || !(gap > 0.0)) {
+        return vec2<f32>(0.0, -1.0);
+    }
+    let beta = params.sigma_h * fd - dz;
+    let q = 0.5 * params.sigma_h * fdd;
+    // The f32 margin on f″ widens both bounds: it joins the window's cubic term.
+    let r = params.sigma_h * jerk / 6.0;
+    let qm = 0.5 * params.sigma_h * CUBIC_MARGIN * curv;
+    var window = 1.25 * first_root(gap, beta, q);
+    for (var k = 0u; k < 2u; k = k + 1u) {
+        if (!(window < 1e30)) {
+            return vec2<f32>(0.0, -1.0);
+        }
+        let spread = r * window + qm;
+        let dp = beta * beta + 4.0 * (q + spread) * gap;
+        let dm = beta * beta + 4.0 * (q - spread) * gap;
+        if (!(dp >= 0.0 && dm >= 0.0)) {
+            return vec2<f32>(0.0, -1.0);
+        }
+        let rp = sqrt(dp);
+        let rm = sqrt(dm);
+        if (!(beta + rm > 0.0)) {
+            return vec2<f32>(0.0, -1.0);
+        }
+        let hi = 2.0 * gap / (beta + rm);
+        if (hi <= window) {
+            let lo = 2.0 * gap / (beta + rp);
+            let width = 16.0 * spread * gap * gap / ((rp + rm) * (beta + rm) * (beta + rp));
+            return vec2<f32>(lo, width);
+        }
+        window = 1.25 * hi;
+    }
+    return vec2<f32>(0.0, -1.0);
+}
+
 // OctaveSurface::march on the explicit (lod = false) or level-of-detail surface (lod = true, after
 // lod_prepare, whose σ_f is sf): t of the first crossing, or -1 when the ray leaves the slab.
 fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
@@ -243,7 +329,7 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
                 continue;
             }
         }
-        var acc = vec2<f32>(0.0);
+        var acc = vec3<f32>(0.0);
         var start = 0u;
         var have = false;
         var best_s = 0.0;
@@ -266,6 +352,10 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
                 if (br.y >= 0.0 && br.y <= lod_settle) {
                     return t + br.x;
                 }
+                let bc = octave_cubic_bracket(gap, acc.y, acc.z, rw.jerk[l], rw.curv[l], d.z);
+                if (bc.y >= 0.0 && bc.y <= lod_settle) {
+                    return t + bc.x;
+                }
             }
             if (l == last && gap < 0.0) {
                 if (t > 0.0) {
@@ -276,7 +366,9 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
             }
             var found = vec3<f32>(0.0);
             if (gap >= 0.0) {
-                found = vec3<f32>(octave_step(gap, acc.y, rw.lip[l], rw.curv[l], d.z, sg), gap, 1.0);
+                let s = octave_step(gap, acc.y, rw.lip[l], rw.curv[l], d.z, sg);
+                let sc = octave_cubic_step(gap, acc.y, acc.z, rw.jerk[l], rw.curv[l], d.z, s, min_step);
+                found = vec3<f32>(max(s, sc), gap, 1.0);
             }
             found = octave_local_step(found, above, acc.x, acc.y, rw.lip[l], rw.curv[l], rw.resid[l], d.z, lod, sf, min_step);
             if (found.z > 0.0) {
