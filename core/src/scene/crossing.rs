@@ -59,14 +59,18 @@ impl OctaveSurface<'_> {
         Some((lo, width))
     }
 
-    /// The safe step from the gap's third-order bound (identity transfer): with the level's exact
-    /// `f′ = fd` and `f″ = fdd` at the point and `|f‴| ≤ J = jerk` (`Σ|a_i||ω_i|³`),
-    /// `γ(t + s) ≥ γ − βs − q s² − r s³` with `β = σ_h f′ − d_z`, `q = σ_h f″/2`, `r = σ_h J/6`.
-    /// On a window `s ≤ S` the cubic is at least the quadratic with `c = q + rS`, whose first root
-    /// ([`first_root`]) capped at S is safe. Unlike [`OctaveSurface::step`]'s global curvature
-    /// `M = Σ|a_i|ω_i²` (every wave at its crest), this uses the curvature the ray has, so near a
-    /// crossing it steps much closer. Windows: `2·from` (from: a step already proven safe), then
-    /// each step found. 0 when G is not linear or the gap is not positive.
+    /// The safe step from the gap's third-order bound: with the level's exact `f′ = fd` and
+    /// `f″ = fdd` at the point and `|f‴| ≤ J = jerk` (`Σ|a_i||ω_i|³`),
+    /// `γ(t + s) ≥ γ − βs − q s² − r s³` where, for the identity, `β = σ_h f′ − d_z`,
+    /// `q = σ_h f″/2`, `r = σ_h J/6` (Taylor), and for a transfer curve with `|G′| ≤ g` over the
+    /// range f reaches (`sg = σ_h g`), `β = sg|f′| − d_z`, `q = sg|f″|/2`, `r = sg J/6`
+    /// (`|G(f(t+s)) − G(f(t))| ≤ g|f(t+s) − f(t)|` and Taylor on f). On a window `s ≤ S` the cubic
+    /// is at least the quadratic with `c = q + rS`, whose first root ([`first_root`]) capped at S is
+    /// safe. Unlike [`OctaveSurface::step`]'s global curvature `M = Σ|a_i|ω_i²` (every wave at its
+    /// crest), this uses the curvature the ray has, so near a crossing it steps much closer.
+    /// Windows: `2·from` (from: a step already proven safe), then each step found. 0 when the gap
+    /// is not positive.
+    #[allow(clippy::too_many_arguments)]
     pub(crate) fn cubic_step(
         &self,
         gap: f64,
@@ -75,12 +79,17 @@ impl OctaveSurface<'_> {
         jerk: f64,
         dz: f64,
         from: f64,
+        sg: f64,
     ) -> f64 {
-        if !self.linear || !(gap > 0.0) {
+        if !(gap > 0.0) {
             return 0.0;
         }
-        let beta = self.sigma_h * fd - dz;
-        let (q, r) = (0.5 * self.sigma_h * fdd, self.sigma_h * jerk / 6.0);
+        let (beta, q, r) = if self.linear {
+            let s = self.sigma_h;
+            (s * fd - dz, 0.5 * s * fdd, s * jerk / 6.0)
+        } else {
+            (sg * fd.abs() - dz, 0.5 * sg * fdd.abs(), sg * jerk / 6.0)
+        };
         let mut window = 2.0 * from.max(self.min_step);
         let mut best = 0.0f64;
         for _ in 0..CUBIC_TRIES {
@@ -216,13 +225,13 @@ mod tests {
         }
     }
 
-    /// The third-order step and bracket on random sums of cosines along a ray, checked by a dense
-    /// scan of the exact gap: no crossing within the step, and the first crossing inside the
-    /// bracket. They must also do better than the global-curvature bounds somewhere (not vacuous).
+    /// The third-order step and bracket on random sums of cosines along a ray (the identity, and a
+    /// transfer curve for the step), checked by a dense scan of the exact gap: no crossing within
+    /// the step, and the first crossing inside the bracket. They must also do better than the global-curvature bounds somewhere (not vacuous).
     #[test]
     fn cubic_bounds_hold_on_random_waves() {
         let mut rng = 5u64;
-        let (mut longer, mut narrower, mut brackets) = (0, 0, 0);
+        let (mut longer, mut longer_curve, mut narrower, mut brackets) = (0, 0, 0, 0);
         for case in 0..400 {
             let n = 1 + case % 24;
             let waves: Vec<(f64, f64, f64)> = (0..n)
@@ -232,7 +241,12 @@ mod tests {
                     (a, om, std::f64::consts::TAU * splitmix(&mut rng))
                 })
                 .collect();
-            let s = surface(0.05 + splitmix(&mut rng));
+            // A quarter of the cases under a transfer curve G(f) = f + 0.3 sin 3f, |G′| ≤ 1.9.
+            let curve = case % 4 >= 2;
+            let mut s = surface(0.05 + splitmix(&mut rng));
+            s.linear = !curve;
+            let g = |x: f64| if curve { x + 0.3 * (3.0 * x).sin() } else { x };
+            let sg = s.sigma_h * if curve { 1.9 } else { 1.0 };
             let dz = -(0.02 + splitmix(&mut rng));
             let f = |t: f64| {
                 waves
@@ -243,11 +257,11 @@ mod tests {
             let total: f64 = waves.iter().map(|w| w.0).sum();
             // Half the rays start high in the slab, half just above the surface.
             let z0 = if case % 2 == 0 {
-                s.sigma_h * total * (0.2 + 0.8 * splitmix(&mut rng))
+                s.sigma_h * (total + 0.3) * (0.2 + 0.8 * splitmix(&mut rng))
             } else {
-                s.sigma_h * (f(0.0) + total * 1e-3 * splitmix(&mut rng))
+                s.sigma_h * (g(f(0.0)) + total * 1e-3 * splitmix(&mut rng))
             };
-            let gap = |t: f64| z0 + dz * t - s.sigma_h * f(t);
+            let gap = |t: f64| z0 + dz * t - s.sigma_h * g(f(t));
             let g0 = gap(0.0);
             if !(g0 > 0.0) {
                 continue;
@@ -263,8 +277,8 @@ mod tests {
             let jerk: f64 = waves.iter().map(|&(a, om, _)| a * om.abs().powi(3)).sum();
             let curv: f64 = waves.iter().map(|&(a, om, _)| a * om * om).sum();
             let lip: f64 = waves.iter().map(|&(a, om, _)| a * om.abs()).sum();
-            let global = s.step(g0, fd, lip, curv, dz, s.sigma_h);
-            let step = s.cubic_step(g0, fd, fdd, jerk, dz, global);
+            let global = s.step(g0, fd, lip, curv, dz, sg);
+            let step = s.cubic_step(g0, fd, fdd, jerk, dz, global, sg);
             // The first crossing by a dense scan (to the end of the longer of the two windows).
             let end = 4.0 * global.max(step).min(1e3) + 1.0;
             let scan = 40_000;
@@ -283,6 +297,7 @@ mod tests {
             }
             if step > global * (1.0 + 1e-9) {
                 longer += 1;
+                longer_curve += usize::from(curve);
             }
             if let Some((lo, width)) = s.cubic_bracket(g0, fd, fdd, jerk, dz) {
                 brackets += 1;
@@ -300,7 +315,10 @@ mod tests {
                 }
             }
         }
-        assert!(longer > 100, "{longer} longer steps");
+        assert!(
+            longer > 100 && longer_curve > 30,
+            "{longer} longer steps, {longer_curve} on a curve"
+        );
         assert!(
             brackets > 50 && narrower > brackets / 2,
             "{narrower} of {brackets}"

@@ -53,7 +53,7 @@ impl OctaveSurface<'_> {
         };
         let sg = self.sigma_h * self.g_lip;
         let found = Some((self.step(lo, fd, lip, curv, d.z, sg), lo));
-        match self.local_step(found, above, pr.value, fd, (e, lip, curv), d.z) {
+        match self.local_step(found, above, pr.value, fd, (e, lip, curv), d.z, None) {
             Some((s, gap)) if s.is_finite() && s >= self.min_step => FieldStep::Clear(s, gap),
             _ => FieldStep::Unsure,
         }

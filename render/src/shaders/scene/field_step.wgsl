@@ -33,7 +33,7 @@ fn octave_field_step(p: vec3<f32>, d: vec3<f32>, lip: f32, curv: f32, lod: bool,
     }
     let sg = params.sigma_h * params.g_lip;
     let found = vec3<f32>(octave_step(lo, fd, lip, curv, d.z, sg), lo, 1.0);
-    let best = octave_local_step(found, above, pr.x, fd, lip, curv, e, d.z, lod, sf, min_step);
+    let best = octave_local_step(found, above, pr.x, fd, lip, curv, e, d.z, lod, sf, min_step, vec2<f32>(0.0, -1.0));
     if (best.z > 0.0 && best.x < 1e30 && best.x >= min_step) {
         return vec3<f32>(2.0, best.x, best.y);
     }

@@ -145,7 +145,8 @@ fn octave_step(gap: f32, fd: f32, lip: f32, curv: f32, dz: f32, sg: f32) -> f32 
 
 // OctaveSurface::local_step: lengthen the level's (step, gap, found) by the local Lipschitz constant
 // of G over the range f can reach in trial steps growing 8× (at most four); above = z − σ_h·G(f_l).
-fn octave_local_step(found_in: vec3<f32>, above: f32, f: f32, fd: f32, lip: f32, curv: f32, resid: f32, dz: f32, lod: bool, sf: f32, min_step: f32) -> vec3<f32> {
+// cubic = (f_l″, J_l) for the third-order step, (0, −1) to leave it out (the field table's steps).
+fn octave_local_step(found_in: vec3<f32>, above: f32, f: f32, fd: f32, lip: f32, curv: f32, resid: f32, dz: f32, lod: bool, sf: f32, min_step: f32, cubic: vec2<f32>) -> vec3<f32> {
     var found = found_in;
 //#if transfer_curve
     if (params.transfer_kind == TRANSFER_IDENTITY || (found.z > 0.0 && found.x >= 1e30)) {
@@ -159,7 +160,10 @@ fn octave_local_step(found_in: vec3<f32>, above: f32, f: f32, fd: f32, lip: f32,
         if (!(gap >= 0.0)) {
             break;
         }
-        let s = octave_step(gap, fd, lip, curv, dz, sg);
+        var s = octave_step(gap, fd, lip, curv, dz, sg);
+        if (cubic.y >= 0.0) {
+            s = max(s, octave_cubic_step(gap, fd, cubic.x, cubic.y, curv, dz, min(s, trial), min_step, sg));
+        }
         let step = min(s, trial);
         if (found.z > 0.0) {
             found = vec3<f32>(max(found.x, step), max(found.y, gap), 1.0);
@@ -215,15 +219,21 @@ fn first_root(gap: f32, beta: f32, c: f32) -> f32 {
 // term over at most 256 terms); the third-order bounds widen q by it.
 const CUBIC_MARGIN: f32 = 1e-4;
 
-// OctaveSurface::cubic_step: the safe step from the gap's third-order bound (identity transfer),
-// windows 2·safe (a step already proven safe) then each step found; 0 when it does not apply.
-fn octave_cubic_step(gap: f32, fd: f32, fdd: f32, jerk: f32, curv: f32, dz: f32, safe: f32, min_step: f32) -> f32 {
-    if (params.transfer_kind != TRANSFER_IDENTITY || !(gap > 0.0)) {
+// OctaveSurface::cubic_step: the safe step from the gap's third-order bound (the identity, or a
+// transfer curve with |G′| ≤ sg/σ_h), windows 2·safe (a step already proven safe) then each step
+// found; 0 when the gap is not positive.
+fn octave_cubic_step(gap: f32, fd: f32, fdd: f32, jerk: f32, curv: f32, dz: f32, safe: f32, min_step: f32, sg: f32) -> f32 {
+    if (!(gap > 0.0)) {
         return 0.0;
     }
-    let beta = params.sigma_h * fd - dz;
-    let q = 0.5 * params.sigma_h * (fdd + CUBIC_MARGIN * curv);
-    let r = params.sigma_h * jerk / 6.0;
+    var beta = sg * abs(fd) - dz;
+    var q = 0.5 * sg * (abs(fdd) + CUBIC_MARGIN * curv);
+    var r = sg * jerk / 6.0;
+    if (params.transfer_kind == TRANSFER_IDENTITY) {
+        beta = params.sigma_h * fd - dz;
+        q = 0.5 * params.sigma_h * (fdd + CUBIC_MARGIN * curv);
+        r = params.sigma_h * jerk / 6.0;
+    }
     var window = 2.0 * max(safe, min_step);
     var best = 0.0;
     for (var k = 0u; k < 3u; k = k + 1u) {
@@ -367,10 +377,10 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
             var found = vec3<f32>(0.0);
             if (gap >= 0.0) {
                 let s = octave_step(gap, acc.y, rw.lip[l], rw.curv[l], d.z, sg);
-                let sc = octave_cubic_step(gap, acc.y, acc.z, rw.jerk[l], rw.curv[l], d.z, s, min_step);
+                let sc = octave_cubic_step(gap, acc.y, acc.z, rw.jerk[l], rw.curv[l], d.z, s, min_step, sg);
                 found = vec3<f32>(max(s, sc), gap, 1.0);
             }
-            found = octave_local_step(found, above, acc.x, acc.y, rw.lip[l], rw.curv[l], rw.resid[l], d.z, lod, sf, min_step);
+            found = octave_local_step(found, above, acc.x, acc.y, rw.lip[l], rw.curv[l], rw.resid[l], d.z, lod, sf, min_step, vec2<f32>(acc.z, rw.jerk[l]));
             if (found.z > 0.0) {
                 known = max(known, found.y);
                 if (!have || found.x > best_s) {
