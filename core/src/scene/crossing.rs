@@ -24,6 +24,26 @@ pub(crate) fn first_root(gap: f64, beta: f64, c: f64) -> f64 {
     }
 }
 
+/// The bracket `(s_lo, s_hi, s_hi − s_lo)` of the first zero of a gap with
+/// `γ − βs − c₊s² ≤ γ(t + s) ≤ γ − βs − c₋s²`, `c± = c ± spread` (spread ≥ 0, γ > 0): `s_lo` and
+/// `s_hi` the two bounds' first roots ([`first_root`]), the width written without their
+/// difference, `16·spread·γ²/((√D₊ + √D₋)(β + √D₋)(β + √D₊))` with `D± = β² + 4c±γ`, so f32
+/// keeps it to relative rounding. `None` when the upper bound never reaches 0.
+fn quadratic_bracket(gap: f64, beta: f64, c: f64, spread: f64) -> Option<(f64, f64, f64)> {
+    let (cp, cm) = (c + spread, c - spread);
+    let (dp, dm) = (beta * beta + 4.0 * cp * gap, beta * beta + 4.0 * cm * gap);
+    if !(dp >= 0.0 && dm >= 0.0) {
+        return None;
+    }
+    let (rp, rm) = (dp.sqrt(), dm.sqrt());
+    if !(beta + rm > 0.0) {
+        return None;
+    }
+    let (lo, hi) = (2.0 * gap / (beta + rp), 2.0 * gap / (beta + rm));
+    let width = 16.0 * spread * gap * gap / ((rp + rm) * (beta + rm) * (beta + rp));
+    Some((lo, hi, width))
+}
+
 /// How many times [`OctaveSurface::cubic_step`] re-solves with the window it last found.
 const CUBIC_TRIES: usize = 3;
 
@@ -49,14 +69,7 @@ impl OctaveSurface<'_> {
         }
         let beta = self.sigma_h * fd - dz;
         let c = 0.5 * self.sigma_h * curv;
-        let (dp, dm) = (beta * beta + 4.0 * c * gap, beta * beta - 4.0 * c * gap);
-        if !(beta > 0.0 && dm >= 0.0) {
-            return None;
-        }
-        let (rp, rm) = (dp.sqrt(), dm.sqrt());
-        let lo = 2.0 * gap / (beta + rp);
-        let width = 16.0 * c * gap * gap / ((rp + rm) * (beta + rm) * (beta + rp));
-        Some((lo, width))
+        quadratic_bracket(gap, beta, 0.0, c).map(|(lo, _, width)| (lo, width))
     }
 
     /// The safe step from the gap's third-order bound: with the level's exact `f′ = fd` and
@@ -127,19 +140,8 @@ impl OctaveSurface<'_> {
             if !window.is_finite() {
                 return None;
             }
-            let (cp, cm) = (q + r * window, q - r * window);
-            let (dp, dm) = (beta * beta + 4.0 * cp * gap, beta * beta + 4.0 * cm * gap);
-            if !(dp >= 0.0 && dm >= 0.0) {
-                return None;
-            }
-            let (rp, rm) = (dp.sqrt(), dm.sqrt());
-            if !(beta + rm > 0.0) {
-                return None;
-            }
-            let hi = 2.0 * gap / (beta + rm);
+            let (lo, hi, width) = quadratic_bracket(gap, beta, q, r * window)?;
             if hi <= window {
-                let lo = 2.0 * gap / (beta + rp);
-                let width = 16.0 * r * window * gap * gap / ((rp + rm) * (beta + rm) * (beta + rp));
                 return Some((lo, width));
             }
             window = 1.25 * hi;
