@@ -72,6 +72,17 @@ impl OctaveSurface<'_> {
         quadratic_bracket(gap, beta, 0.0, c).map(|(lo, _, width)| (lo, width))
     }
 
+    /// The third-order bound's `(β, q, r)` ([`OctaveSurface::cubic_step`]): from σ_h and the signed
+    /// derivatives for the identity, from `sg` and their magnitudes under a transfer curve.
+    fn cubic_terms(&self, fd: f64, fdd: f64, jerk: f64, dz: f64, sg: f64) -> (f64, f64, f64) {
+        if self.linear {
+            let s = self.sigma_h;
+            (s * fd - dz, 0.5 * s * fdd, s * jerk / 6.0)
+        } else {
+            (sg * fd.abs() - dz, 0.5 * sg * fdd.abs(), sg * jerk / 6.0)
+        }
+    }
+
     /// The safe step from the gap's third-order bound: with the level's exact `f′ = fd` and
     /// `f″ = fdd` at the point and `|f‴| ≤ J = jerk` (`Σ|a_i||ω_i|³`),
     /// `γ(t + s) ≥ γ − βs − q s² − r s³` where, for the identity, `β = σ_h f′ − d_z`,
@@ -97,12 +108,7 @@ impl OctaveSurface<'_> {
         if !(gap > 0.0) {
             return 0.0;
         }
-        let (beta, q, r) = if self.linear {
-            let s = self.sigma_h;
-            (s * fd - dz, 0.5 * s * fdd, s * jerk / 6.0)
-        } else {
-            (sg * fd.abs() - dz, 0.5 * sg * fdd.abs(), sg * jerk / 6.0)
-        };
+        let (beta, q, r) = self.cubic_terms(fd, fdd, jerk, dz, sg);
         let mut window = 2.0 * from.max(self.min_step);
         let mut best = 0.0f64;
         for _ in 0..CUBIC_TRIES {
@@ -133,8 +139,7 @@ impl OctaveSurface<'_> {
         if !self.linear || !(gap > 0.0) {
             return None;
         }
-        let beta = self.sigma_h * fd - dz;
-        let (q, r) = (0.5 * self.sigma_h * fdd, self.sigma_h * jerk / 6.0);
+        let (beta, q, r) = self.cubic_terms(fd, fdd, jerk, dz, self.sigma_h);
         let mut window = 1.25 * first_root(gap, beta, q);
         for _ in 0..2 {
             if !window.is_finite() {
