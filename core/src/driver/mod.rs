@@ -2,6 +2,7 @@
 //! sum-of-sinusoids noise (analytic attenuation), an image driver (its pyramid), and the
 //! [`field::DriverField`] that is either.
 
+pub mod conditional_slopes;
 pub mod field;
 pub mod footprint;
 pub mod histogram;

@@ -22,7 +22,18 @@
 //! map (driver or height source) or the HN12 attribute at the point's standardized height
 //! (clamped at 0). CPU only: compared with the ground truth by `lodestone diagnose` before the
 //! model adopts it.
+//!
+//! **Image drivers.** An image's value and gradient are not independent: the nodes carry the
+//! image's values `T⁻¹(μ_G + σ_G z)` where it keeps its histogram
+//! ([`crate::driver::histogram`]), and node z gets the slope covariance
+//! `Σ_∇f · s²(f_z) / E_z[s²]` with `s²` the image's conditional slope scale
+//! ([`ConditionalSlopes`], normalized over the footprint's nodes so the total stays the
+//! pyramid's). Cobblestones' far patch against the truth (`tests/tests/image_slopes.rs`): one
+//! Gaussian −2.2% at 0°, −2.2% at 60° (light 30° opposite), +7.8% and +17.4% at 85°; value-
+//! conditioned +0.5%, 0.0%, +0.1%, +2.2%. Without `s²` the mixture is the model (within 0.1%).
 
+use crate::driver::conditional_slopes::ConditionalSlopes;
+use crate::driver::histogram::DriverHistogram;
 use crate::eval::shading::SlopeShading;
 use crate::eval::{Evaluator, FootprintQuery};
 use crate::material::color_terms::Affine;
@@ -83,11 +94,41 @@ impl Evaluator {
             s_o: f64,
             spec: f64,
         }
+        // An image driver: its values T⁻¹(μ_G + σ_G z) where it keeps its histogram, and its
+        // slopes' dependence on the value ([`ConditionalSlopes`]), normalized over the footprint.
+        let image = self.surface.driver.image().map(|t| {
+            let hist = m
+                .image_histogram()
+                .then(|| DriverHistogram::of_image(&t.image));
+            (hist, ConditionalSlopes::of_image(&t.image))
+        });
+        let values: Vec<f64> = match &image {
+            Some((Some(h), _)) => {
+                let (mu, sg) = h.gaussianize(d.mean, d.std);
+                zs.iter().map(|&z| h.inverse(mu + sg * z)).collect()
+            }
+            _ => zs.iter().map(|&z| d.mean + d.std * z).collect(),
+        };
+        let slope_scale: Vec<f64> = match &image {
+            Some((_, c)) => {
+                let raw: Vec<f64> = values.iter().map(|&f| c.scale_at(f)).collect();
+                let mean = raw
+                    .iter()
+                    .zip(&zs)
+                    .map(|(s, &z)| s * norm_pdf(z))
+                    .sum::<f64>()
+                    / total;
+                raw.iter()
+                    .map(|s| if mean > 0.0 { (s / mean).sqrt() } else { 1.0 })
+                    .collect()
+            }
+            _ => vec![1.0; NODES],
+        };
         let nodes: Vec<Node> = zs
             .iter()
-            .map(|&z| {
-                let f = d.mean + d.std * z;
-                let gd = m.heights.transfer.derivative(f);
+            .zip(values.iter().zip(&slope_scale))
+            .map(|(&z, (&f, &scale))| {
+                let gd = m.heights.transfer.derivative(f) * scale;
                 let mean = d.mean_gradient * (sigma_h * gd);
                 let cov = d.gradient_cov.scaled(sigma_h * gd);
                 let ms = G2::new(

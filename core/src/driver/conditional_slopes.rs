@@ -1,0 +1,130 @@
+//! How an image driver's slopes depend on its value (#17, cobblestones): `s²(f) = E[|∇f|² | f] /
+//! E[|∇f|²]` over the explicit (bilinear) surface, in bins of equal probability.
+//!
+//! A Gaussian field's value and gradient at a point are independent, so for the noise driver
+//! `s² ≡ 1` and a footprint's slopes are one Gaussian given any value. An image need not be: the
+//! cobblestones image has flat stone tops (its top sixteenth of values: s² = 0.13) and steep
+//! flanks and mortar (its second to fourth sixteenths: s² = 2.2–2.9). A model that draws every
+//! value's slopes from the footprint's one slope covariance then gives the bright tops the slopes
+//! of the flanks, and the colour–shading correlation is lost.
+//!
+//! **Use** (the prototype [`crate::eval::Evaluator::filtered_mixture`]): a footprint's points of
+//! value f get the slope covariance `Σ_∇f · s²(f) / E_fp[s²]`, where `E_fp` averages over the
+//! footprint's own value distribution. The footprint's total slope covariance stays what the
+//! pyramid says; only its split among values follows the image's global conditional. A footprint
+//! that sees one value (a texel on a flank) is unchanged (its s² ratio is 1 everywhere), so the
+//! near field keeps the pyramid's local statistics.
+
+use crate::driver::image::ImageDriver;
+use glam::DVec2;
+
+/// Bins of equal probability of the value.
+pub const BINS: usize = 32;
+
+/// Samples of the bilinear surface used (at most).
+const MAX_SAMPLES: usize = 1 << 20;
+
+/// `s²(f)` of an image driver (module docs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ConditionalSlopes {
+    /// The bins' value edges, increasing (`BINS + 1` of them; equal edges where the image has a
+    /// plateau).
+    pub edges: Vec<f64>,
+    /// `E[|∇f|² | bin] / E[|∇f|²]` per bin (1 everywhere for a flat image).
+    pub scale: Vec<f64>,
+}
+
+impl ConditionalSlopes {
+    /// The conditional of an image's explicit surface, sampled on a regular sub-grid of each cell
+    /// (as [`crate::driver::histogram::DriverHistogram::of_image`] samples its values).
+    pub fn of_image(image: &ImageDriver) -> Self {
+        let (w, h) = image.size();
+        let per_cell = ((MAX_SAMPLES / (w * h).max(1)) as f64)
+            .sqrt()
+            .floor()
+            .clamp(1.0, 4.0) as usize;
+        let mut samples = Vec::with_capacity(w * h * per_cell * per_cell);
+        for y in 0..h {
+            for x in 0..w {
+                for j in 0..per_cell {
+                    for i in 0..per_cell {
+                        let p = DVec2::new(
+                            x as f64 + 0.5 + (i as f64 + 0.5) / per_cell as f64,
+                            y as f64 + 0.5 + (j as f64 + 0.5) / per_cell as f64,
+                        );
+                        let (f, g) = image.value_and_gradient(p);
+                        samples.push((f, g.length_squared()));
+                    }
+                }
+            }
+        }
+        Self::from_samples(samples)
+    }
+
+    /// The conditional of equally weighted `(f, |∇f|²)` samples (non-finite ones dropped).
+    pub fn from_samples(mut samples: Vec<(f64, f64)>) -> Self {
+        samples.retain(|(f, g)| f.is_finite() && g.is_finite());
+        if samples.is_empty() {
+            return Self {
+                edges: vec![0.0; BINS + 1],
+                scale: vec![1.0; BINS],
+            };
+        }
+        samples.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        let n = samples.len();
+        let total = samples.iter().map(|s| s.1).sum::<f64>() / n as f64;
+        let mut edges = Vec::with_capacity(BINS + 1);
+        let mut scale = Vec::with_capacity(BINS);
+        edges.push(samples[0].0);
+        for b in 0..BINS {
+            let (lo, hi) = (
+                b * n / BINS,
+                ((b + 1) * n / BINS).max(b * n / BINS + 1).min(n),
+            );
+            let part = &samples[lo..hi];
+            let mean = part.iter().map(|s| s.1).sum::<f64>() / part.len() as f64;
+            scale.push(if total > 0.0 { mean / total } else { 1.0 });
+            edges.push(part[part.len() - 1].0);
+        }
+        Self { edges, scale }
+    }
+
+    /// `s²(f)`: the scale of the bin holding f (the end bins beyond the range).
+    pub fn scale_at(&self, f: f64) -> f64 {
+        let k = self.edges[1..BINS].partition_point(|&e| e < f);
+        self.scale[k.min(BINS - 1)]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A surface whose slopes are twice as large (s² four times) above the median as below: the
+    /// bins say so, and their mean is 1 (s² is normalized by the overall mean).
+    #[test]
+    fn the_conditional_follows_the_samples_and_averages_to_one() {
+        let samples: Vec<(f64, f64)> = (0..10_000)
+            .map(|i| {
+                let f = i as f64 / 10_000.0;
+                (f, if f < 0.5 { 1.0 } else { 4.0 })
+            })
+            .collect();
+        let c = ConditionalSlopes::from_samples(samples);
+        assert!((c.scale_at(0.1) - 0.4).abs() < 1e-9, "{}", c.scale_at(0.1));
+        assert!((c.scale_at(0.9) - 1.6).abs() < 1e-9, "{}", c.scale_at(0.9));
+        assert!((c.scale_at(-5.0) - 0.4).abs() < 1e-9);
+        assert!((c.scale_at(5.0) - 1.6).abs() < 1e-9);
+        let mean = c.scale.iter().sum::<f64>() / BINS as f64;
+        assert!((mean - 1.0).abs() < 1e-12, "{mean}");
+    }
+
+    /// A constant image (no slopes anywhere) gives 1 in every bin, not NaN.
+    #[test]
+    fn a_flat_image_has_unit_scale() {
+        let c = ConditionalSlopes::from_samples(vec![(0.3, 0.0); 100]);
+        assert!(c.scale.iter().all(|&s| s == 1.0));
+        assert_eq!(c.scale_at(0.3), 1.0);
+        assert_eq!(ConditionalSlopes::from_samples(vec![]).scale_at(1.0), 1.0);
+    }
+}
