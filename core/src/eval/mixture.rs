@@ -404,3 +404,91 @@ mod binning {
         }
     }
 }
+
+#[cfg(test)]
+mod image_tests {
+    use crate::driver::image::ImageDriver;
+    use crate::driver::test_images;
+    use crate::eval::{Evaluator, FootprintQuery};
+    use crate::scene::direction::direction;
+    use std::sync::Arc;
+
+    /// The far patch of the cobblestones material with each generated test image as its driver:
+    /// (image, whether it is far from Gaussian, view, light azimuth, model's relative error,
+    /// the value-conditioned mixture's, the truth's relative standard error), worst channel.
+    fn errors(
+        views: &[f64],
+        azimuths: &[f64],
+    ) -> Vec<(&'static str, bool, f64, f64, f64, f64, f64)> {
+        let base = crate::eval::test_materials::preset("cobblestones");
+        let mut rows = vec![];
+        for (name, img, skewed) in test_images::all() {
+            let image = ImageDriver::new(test_images::SIDE, test_images::SIDE, &img).unwrap();
+            let p = Evaluator::with_image(&base, Some(Arc::new(image)), None).unwrap();
+            for &view in views {
+                for &azimuth in azimuths {
+                    let cfg = FootprintQuery::far(
+                        &p,
+                        direction(view.to_radians(), 0.0),
+                        direction(30f64.to_radians(), azimuth.to_radians()),
+                    );
+                    let t = p.ground_truth(&cfg, 20_000, 1);
+                    let err = |v: [f64; 3]| {
+                        (0..3)
+                            .map(|k| (v[k] - t.mean[k]) / t.mean[k])
+                            .fold(0.0f64, |a, e| if e.abs() > a.abs() { e } else { a })
+                    };
+                    let model = err(p.filtered(&cfg));
+                    let mixture = err(p.filtered_mixture(&cfg).unwrap());
+                    let se = (0..3)
+                        .map(|k| t.std_error[k] / t.mean[k])
+                        .fold(0.0, f64::max);
+                    eprintln!(
+                        "{name:<18} view {view:>2}° light 30°/{azimuth:>3}°: model {:+.2}%, \
+                         conditioned {:+.2}% (s.e. {:.2}%)",
+                        100.0 * model,
+                        100.0 * mixture,
+                        100.0 * se
+                    );
+                    rows.push((name, skewed, view, azimuth, model, mixture, se));
+                }
+            }
+        }
+        rows
+    }
+
+    /// Issue #17 item 6, at the normal view (no masking: what the slopes' split among values
+    /// does alone). On the generated non-Gaussian images the one-Gaussian model is 10–22% off
+    /// (the slopes of flat tops and steep edges pooled); the value-conditioned slopes are within
+    /// 2.5%, at least three times closer; the Gaussian-like control is unchanged.
+    #[test]
+    fn value_conditioned_slopes_fix_the_test_images_at_the_normal_view() {
+        for (name, skewed, _, _, model, mixture, se) in errors(&[0.0], &[180.0]) {
+            if skewed && model.abs() > 0.03 {
+                assert!(
+                    mixture.abs() * 3.0 <= model.abs(),
+                    "{name}: {mixture} against {model}"
+                );
+                assert!(mixture.abs() <= 0.025 + 3.0 * se, "{name}: {mixture}");
+            } else {
+                assert!(
+                    (mixture - model).abs() <= 0.002,
+                    "{name}: {mixture} against {model}"
+                );
+            }
+        }
+    }
+
+    /// The whole grid (views 0°, 60°, 85° × light 30° on the view's side and opposite), printed:
+    /// `cargo test --release -p lodestone-core -- --ignored image_tests --nocapture`.
+    /// Measured 2026-12-03: at 0° and 60° (light opposite) the conditioned slopes are 3–17×
+    /// closer on every skewed image; at 60° with the light on the view's side bricks gets worse
+    /// (−4.8% → −7.4%) and cracked mud changes sign (+3.9% → −3.8%); at 85° both are far off on
+    /// bricks, gravel, cracked mud and tiles (to −59%/+130%: masking on plateaus and grooves).
+    #[test]
+    #[ignore = "measurement: prints the grid"]
+    fn value_conditioned_slopes_on_the_test_images_grid() {
+        let rows = errors(&[0.0, 60.0, 85.0], &[0.0, 180.0]);
+        assert_eq!(rows.len(), 36);
+    }
+}
