@@ -16,7 +16,6 @@
 //! near field keeps the pyramid's local statistics.
 
 use crate::driver::image::ImageDriver;
-use glam::DVec2;
 
 /// Bins of equal probability of the value.
 pub const BINS: usize = 32;
@@ -38,26 +37,8 @@ impl ConditionalSlopes {
     /// The conditional of an image's explicit surface, sampled on a regular sub-grid of each cell
     /// (as [`crate::driver::histogram::DriverHistogram::of_image`] samples its values).
     pub fn of_image(image: &ImageDriver) -> Self {
-        let (w, h) = image.size();
-        let per_cell = ((MAX_SAMPLES / (w * h).max(1)) as f64)
-            .sqrt()
-            .floor()
-            .clamp(1.0, 4.0) as usize;
-        let mut samples = Vec::with_capacity(w * h * per_cell * per_cell);
-        for y in 0..h {
-            for x in 0..w {
-                for j in 0..per_cell {
-                    for i in 0..per_cell {
-                        let p = DVec2::new(
-                            x as f64 + 0.5 + (i as f64 + 0.5) / per_cell as f64,
-                            y as f64 + 0.5 + (j as f64 + 0.5) / per_cell as f64,
-                        );
-                        let (f, g) = image.value_and_gradient(p);
-                        samples.push((f, g.length_squared()));
-                    }
-                }
-            }
-        }
+        let mut samples = Vec::new();
+        image.for_each_surface_sample(MAX_SAMPLES, |f, g| samples.push((f, g.length_squared())));
         Self::from_samples(samples)
     }
 

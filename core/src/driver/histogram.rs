@@ -27,7 +27,6 @@ use crate::driver::image::ImageDriver;
 use crate::material::preconvolved::PreconvolvedTable;
 use crate::math::piecewise::{PiecewisePoly, fast_upper};
 use crate::math::special::{norm_pdf, norm_quantile};
-use glam::DVec2;
 use serde::{Deserialize, Serialize};
 
 /// How the filtered view models an image driver's values inside a footprint.
@@ -73,25 +72,8 @@ impl DriverHistogram {
     /// standardized texels, [`ImageDriver::value_and_gradient`]), sampled on a regular sub-grid of
     /// each cell.
     pub fn of_image(image: &ImageDriver) -> Self {
-        let (w, h) = image.size();
-        let per_cell = ((MAX_SAMPLES / (w * h).max(1)) as f64)
-            .sqrt()
-            .floor()
-            .clamp(1.0, 4.0) as usize;
-        let mut samples = Vec::with_capacity(w * h * per_cell * per_cell);
-        for y in 0..h {
-            for x in 0..w {
-                for j in 0..per_cell {
-                    for i in 0..per_cell {
-                        let p = DVec2::new(
-                            x as f64 + 0.5 + (i as f64 + 0.5) / per_cell as f64,
-                            y as f64 + 0.5 + (j as f64 + 0.5) / per_cell as f64,
-                        );
-                        samples.push(image.value_and_gradient(p).0);
-                    }
-                }
-            }
-        }
+        let mut samples = Vec::new();
+        image.for_each_surface_sample(MAX_SAMPLES, |f, _| samples.push(f));
         Self::from_samples(samples)
     }
 
@@ -418,7 +400,7 @@ mod tests {
     use crate::material::colormap::{ColorStop, Gradient, Interpolation};
     use crate::material::preconvolved::TableSpec;
     use crate::math::special::norm_cdf;
-    use glam::DMat2;
+    use glam::{DMat2, DVec2};
 
     fn driver(values: &[f32]) -> ImageDriver {
         ImageDriver::new(test_images::SIDE, test_images::SIDE, values).expect("valid image")

@@ -270,6 +270,32 @@ impl ImageDriver {
         (top + a.y * (bot - top), DVec2::new(fx, fy))
     }
 
+    /// Visit the explicit surface at a regular sub-grid of every cell, `k × k` points per cell
+    /// with `k = ⌊√(max_samples / texels)⌋` clamped to 1…4, row by row: `visit(f, ∇f)`
+    /// ([`Self::value_and_gradient`]). The whole-image statistics (histogram, conditional
+    /// slopes) sample it this way.
+    pub fn for_each_surface_sample(&self, max_samples: usize, mut visit: impl FnMut(f64, DVec2)) {
+        let (w, h) = self.size();
+        let per_cell = ((max_samples / (w * h).max(1)) as f64)
+            .sqrt()
+            .floor()
+            .clamp(1.0, 4.0) as usize;
+        for y in 0..h {
+            for x in 0..w {
+                for j in 0..per_cell {
+                    for i in 0..per_cell {
+                        let p = DVec2::new(
+                            x as f64 + 0.5 + (i as f64 + 0.5) / per_cell as f64,
+                            y as f64 + 0.5 + (j as f64 + 0.5) / per_cell as f64,
+                        );
+                        let (f, g) = self.value_and_gradient(p);
+                        visit(f, g);
+                    }
+                }
+            }
+        }
+    }
+
     /// The sampling plan of a Gaussian footprint with covariance `cov` (texel units): the major axis
     /// σ₁ is covered by n = ⌈σ₁/σ₂⌉ ≤ [`Self::MAX_PROBES`] probes spaced by `√12·σ₁/n`, each a
     /// trilinear lookup whose kernel has std `max(σ₂, σ₁/n)` ([`lod_for_std`]); n kernels spaced by s
