@@ -20,9 +20,6 @@ use crate::driver::image::ImageDriver;
 /// Bins of equal probability of the value.
 pub const BINS: usize = 32;
 
-/// Samples of the bilinear surface used (at most).
-const MAX_SAMPLES: usize = 1 << 20;
-
 /// `s²(f)` of an image driver (module docs).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ConditionalSlopes {
@@ -38,7 +35,7 @@ impl ConditionalSlopes {
     /// (as [`crate::driver::histogram::DriverHistogram::of_image`] samples its values).
     pub fn of_image(image: &ImageDriver) -> Self {
         let mut samples = Vec::new();
-        image.for_each_surface_sample(MAX_SAMPLES, |f, g| samples.push((f, g.length_squared())));
+        image.for_each_surface_sample(|f, g| samples.push((f, g.length_squared())));
         Self::from_samples(samples)
     }
 

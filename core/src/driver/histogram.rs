@@ -55,8 +55,6 @@ pub const SIGMA_G_MAX: f64 = 4.0;
 /// Knots of `T⁻¹` that a straight line through their neighbours passes within this fraction of
 /// the value range are dropped (fewer pieces for the tables to integrate; plateaus become one).
 pub const SIMPLIFY_TOLERANCE: f64 = 2e-4;
-/// Samples of the bilinear surface kept for the histogram (at most).
-const MAX_SAMPLES: usize = 1 << 20;
 
 /// The driver's value distribution as `T⁻¹`: G knots and the driver's values there.
 #[derive(Clone, Debug, PartialEq)]
@@ -73,7 +71,7 @@ impl DriverHistogram {
     /// each cell.
     pub fn of_image(image: &ImageDriver) -> Self {
         let mut samples = Vec::new();
-        image.for_each_surface_sample(MAX_SAMPLES, |f, _| samples.push(f));
+        image.for_each_surface_sample(|f, _| samples.push(f));
         Self::from_samples(samples)
     }
 

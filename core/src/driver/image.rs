@@ -127,6 +127,9 @@ pub struct ProbePlan {
     pub step: DVec2,
 }
 
+/// Samples of the bilinear surface the whole-image statistics take (at most): 2²⁰.
+pub const SURFACE_SAMPLES: usize = 1 << 20;
+
 /// A mip-mapped image driver.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ImageDriver {
@@ -271,12 +274,12 @@ impl ImageDriver {
     }
 
     /// Visit the explicit surface at a regular sub-grid of every cell, `k × k` points per cell
-    /// with `k = ⌊√(max_samples / texels)⌋` clamped to 1…4, row by row: `visit(f, ∇f)`
-    /// ([`Self::value_and_gradient`]). The whole-image statistics (histogram, conditional
-    /// slopes) sample it this way.
-    pub fn for_each_surface_sample(&self, max_samples: usize, mut visit: impl FnMut(f64, DVec2)) {
+    /// with `k = ⌊√(SURFACE_SAMPLES / texels)⌋` clamped to 1…4, row by row: `visit(f, ∇f)`
+    /// ([`Self::value_and_gradient`], [`SURFACE_SAMPLES`]). The whole-image statistics
+    /// (histogram, conditional slopes) sample it this way.
+    pub fn for_each_surface_sample(&self, mut visit: impl FnMut(f64, DVec2)) {
         let (w, h) = self.size();
-        let per_cell = ((max_samples / (w * h).max(1)) as f64)
+        let per_cell = ((SURFACE_SAMPLES / (w * h).max(1)) as f64)
             .sqrt()
             .floor()
             .clamp(1.0, 4.0) as usize;
