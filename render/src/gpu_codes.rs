@@ -5,6 +5,8 @@
 //! factor and the march's over-relaxation come from `lodestone-core`, so each has one definition.
 
 use crate::gpu_types::{GpuStruct, MaterialParams};
+use lodestone_core::driver::conditional_slopes;
+use lodestone_core::driver::histogram::G_END;
 use lodestone_core::eval::lod_surface::LOD_SETTLE;
 use lodestone_core::microfacet::effective_height::{
     FIT_ALPHA_MU, FIT_ALPHA_SIGMA, FIT_BETA_MU, FIT_BETA_SIGMA,
@@ -160,6 +162,11 @@ pub fn wgsl_prelude() -> &'static str {
             ("GRID_TRIES", GRID_TRIES as u32),
             ("MIXTURE_BINS", MIXTURE_BINS as u32),
             ("MAX_KNOT_EDGES", MAX_KNOT_EDGES as u32),
+            ("IMAGE_SLOPE_BINS", conditional_slopes::BINS as u32),
+            (
+                "IMAGE_INVERSE_SIZE",
+                conditional_slopes::INVERSE_SIZE as u32,
+            ),
         ];
         for (name, v) in sets.into_iter().flatten().chain(counts) {
             let _ = writeln!(s, "const {name}: u32 = {v}u;");
@@ -176,6 +183,7 @@ pub fn wgsl_prelude() -> &'static str {
             ("GRID_MARGIN", GRID_MARGIN_F32),
             ("FIELD_SETTLE", FIELD_SETTLE),
             ("LOD_SETTLE", LOD_SETTLE),
+            ("HISTOGRAM_G_END", G_END),
         ];
         for (name, v) in floats {
             let _ = writeln!(s, "const {name}: f32 = {:?};", v as f32);

@@ -281,10 +281,12 @@ gpu_struct! {
         ts_offset: u32 => "u32",
         /// Column intervals per pyramid row, rounded up to a power of two (`TableSlope::p`).
         ts_p: u32 => "u32",
-        /// Padding to WGSL's 16-byte struct size.
-        pad1: u32 => "u32",
-        /// Padding to WGSL's 16-byte struct size.
-        pad2: u32 => "u32",
+        /// Offset of an image's value-conditioned slope table (core's
+        /// `driver::conditional_slopes::ImageSlopes`): IMAGE_SLOPE_BINS scales s², then
+        /// IMAGE_INVERSE_SIZE values of T⁻¹.
+        is_offset: u32 => "u32",
+        /// 1 when the mixture's bins carry the image's value-conditioned slopes, 0 otherwise.
+        is_on: u32 => "u32",
         /// Padding to WGSL's 16-byte struct size.
         pad3: u32 => "u32",
     }

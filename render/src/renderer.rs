@@ -513,6 +513,17 @@ pub fn material_data_for(
         base.ht_m_max = t.m_max as f32;
         base.ht_sigma_max = t.sigma_max as f32;
     }
+    if let Some(t) = prepared
+        .image_slopes
+        .as_ref()
+        .filter(|_| features.contains(Feature::TransferMixture))
+    {
+        let start = data.len();
+        base.is_offset = data.len() as u32;
+        base.is_on = 1;
+        data.extend(t.scale.iter().chain(&t.inverse).map(|v| *v as f32));
+        mark(&data, start, "image's value-conditioned slopes and T⁻¹");
+    }
     if let Some(t) = prepared.transfer.table() {
         let start = data.len();
         lay.transfer_table = push_table(&mut data, t);

@@ -45,6 +45,7 @@ pub const MATERIAL_FILES: &[(&str, &str)] = wgsl_files![
     "driver/footprint.wgsl",
     "driver/noise.wgsl",
     "driver/field.wgsl",
+    "driver/conditional_slopes.wgsl",
     "scene/direction.wgsl",
     "scene/bound_grid.wgsl",
     "scene/grid_skip.wgsl",

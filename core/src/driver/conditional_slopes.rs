@@ -15,7 +15,9 @@
 //! that sees one value (a texel on a flank) is unchanged (its s² ratio is 1 everywhere), so the
 //! near field keeps the pyramid's local statistics.
 
+use crate::driver::histogram::{DriverHistogram, G_END};
 use crate::driver::image::ImageDriver;
+use crate::math::special::norm_cdf;
 
 /// Bins of equal probability of the value.
 pub const BINS: usize = 32;
@@ -74,6 +76,68 @@ impl ConditionalSlopes {
     }
 }
 
+/// Entries of [`ImageSlopes::inverse`], uniform in Gaussian space over `[−G_END, G_END]`.
+pub const INVERSE_SIZE: usize = 256;
+
+/// What the views' binned mixture reads for an image driver (the GPU's table, core's mirror):
+/// `s²` over the image's global rank and `T⁻¹` over Gaussian space, both interpolated linearly.
+/// In Gaussian space the rank of value `T⁻¹(G)` is `Φ(G)`, so bin k of [`ConditionalSlopes`]
+/// holds `G ∈ [Φ⁻¹(k/BINS), Φ⁻¹((k+1)/BINS)]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageSlopes {
+    /// `s²` per rank bin ([`ConditionalSlopes::scale`]).
+    pub scale: Vec<f64>,
+    /// `T⁻¹` at `INVERSE_SIZE` points uniform over `[−G_END, G_END]`.
+    pub inverse: Vec<f64>,
+}
+
+impl ImageSlopes {
+    /// The table of an image's conditional and histogram.
+    pub fn new(c: &ConditionalSlopes, h: &DriverHistogram) -> Self {
+        let step = 2.0 * G_END / (INVERSE_SIZE - 1) as f64;
+        Self {
+            scale: c.scale.clone(),
+            inverse: (0..INVERSE_SIZE)
+                .map(|i| h.inverse(-G_END + step * i as f64))
+                .collect(),
+        }
+    }
+
+    /// The table of an image driver's explicit surface.
+    pub fn of_image(image: &ImageDriver) -> Self {
+        Self::new(
+            &ConditionalSlopes::of_image(image),
+            &DriverHistogram::of_image(image),
+        )
+    }
+
+    /// `s²` at Gaussian-space value g: linear between the rank bins' centres (constant beyond
+    /// the first and last), so the views' bins see no jump at a bin edge.
+    pub fn scale_at_gauss(&self, g: f64) -> f64 {
+        lerp_table(&self.scale, norm_cdf(g) * BINS as f64 - 0.5)
+    }
+
+    /// `T⁻¹(g)` from the uniform table (constant beyond ±G_END).
+    pub fn value_at_gauss(&self, g: f64) -> f64 {
+        let x = (g + G_END) / (2.0 * G_END) * (INVERSE_SIZE - 1) as f64;
+        lerp_table(&self.inverse, x)
+    }
+}
+
+/// `t` read at fractional index x, linear between entries, clamped to the ends (NaN: the first).
+fn lerp_table(t: &[f64], x: f64) -> f64 {
+    let last = t.len() - 1;
+    if !(x > 0.0) {
+        return t[0];
+    }
+    if x >= last as f64 {
+        return t[last];
+    }
+    let i = x.floor() as usize;
+    let a = x - i as f64;
+    t[i] + a * (t[i + 1] - t[i])
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -104,5 +168,36 @@ mod tests {
         assert!(c.scale.iter().all(|&s| s == 1.0));
         assert_eq!(c.scale_at(0.3), 1.0);
         assert_eq!(ConditionalSlopes::from_samples(vec![]).scale_at(1.0), 1.0);
+    }
+
+    /// The views' table reads back the conditional and the histogram: at a bin's centre rank the
+    /// bin's s², and T⁻¹ within the histogram's own interpolation at the table's points.
+    #[test]
+    fn the_views_table_reads_back_its_sources() {
+        let image = ImageDriver::new(
+            crate::driver::test_images::SIDE,
+            crate::driver::test_images::SIDE,
+            &crate::driver::test_images::bricks(),
+        )
+        .unwrap();
+        let c = ConditionalSlopes::of_image(&image);
+        let h = DriverHistogram::of_image(&image);
+        let t = ImageSlopes::new(&c, &h);
+        for k in 0..BINS {
+            let g = crate::math::special::norm_quantile((k as f64 + 0.5) / BINS as f64);
+            assert!((t.scale_at_gauss(g) - c.scale[k]).abs() < 1e-9, "bin {k}");
+        }
+        for i in [0, 1, 100, 128, 200, INVERSE_SIZE - 1] {
+            let g = -G_END + 2.0 * G_END * i as f64 / (INVERSE_SIZE - 1) as f64;
+            assert!((t.value_at_gauss(g) - h.inverse(g)).abs() < 1e-12, "{i}");
+        }
+        assert_eq!(t.value_at_gauss(f64::NAN), t.inverse[0]);
+        assert_eq!(t.scale_at_gauss(40.0), c.scale[BINS - 1]);
+        // The bricks' flat tops carry less slope than their mortar edges.
+        assert!(
+            t.scale_at_gauss(2.0) < 0.8 && t.scale_at_gauss(-1.0) > 1.2,
+            "{:?}",
+            c.scale
+        );
     }
 }

@@ -3,6 +3,7 @@
 //! live one per file beside this one.
 
 use crate::driver::DriverError;
+use crate::driver::conditional_slopes::ImageSlopes;
 use crate::driver::field::DriverField;
 use crate::driver::histogram::DriverHistogram;
 use crate::driver::image::ImageDriver;
@@ -29,6 +30,9 @@ pub struct Evaluator {
     pub global_height: (f64, f64),
     /// The slope colour term's map, compiled (when the material has one).
     pub slope_color: Option<CompiledSlopeColor>,
+    /// An image driver's value-conditioned slopes and `T⁻¹` for the mixture's bins, when the
+    /// material uses them ([`Material::image_slope_mixture`]).
+    pub image_slopes: Option<Arc<ImageSlopes>>,
     /// The environment's SH9 radiance with its intensity applied: built for the procedural sky,
     /// set by the application for a file ([`Evaluator::set_environment_map`]); `None` = no
     /// environment light (or a file not loaded yet).
@@ -87,6 +91,13 @@ impl Evaluator {
             }
             _ => CompiledTransfer::new(&material.heights.transfer, spec),
         };
+        let image_slopes = match (material.image_slope_mixture(), surface.driver.image()) {
+            (true, Some(t)) => previous
+                .filter(|p| p.material.driver == material.driver)
+                .and_then(|p| p.image_slopes.clone())
+                .or_else(|| Some(Arc::new(ImageSlopes::of_image(&t.image)))),
+            _ => None,
+        };
         let g = material.heights.transfer.moments(0.0, 1.0);
         let environment = match previous {
             Some(p) if p.material.lighting == material.lighting => p.environment,
@@ -99,6 +110,7 @@ impl Evaluator {
             transfer,
             global_height: (g.mean, g.std.max(1e-12)),
             slope_color: material.terms.slope.as_ref().map(|t| t.color.compiled()),
+            image_slopes,
             environment,
         })
     }

@@ -410,21 +410,27 @@ mod image_tests {
     use crate::driver::image::ImageDriver;
     use crate::driver::test_images;
     use crate::eval::{Evaluator, FootprintQuery};
+    use crate::microfacet::height_mixture::TransferSlopes;
     use crate::scene::direction::direction;
     use std::sync::Arc;
 
     /// The far patch of the cobblestones material with each generated test image as its driver:
-    /// (image, whether it is far from Gaussian, view, light azimuth, model's relative error,
-    /// the value-conditioned mixture's, the truth's relative standard error), worst channel.
+    /// (image, whether it is far from Gaussian, view, light azimuth, the one-Gaussian model's
+    /// relative error (`TransferSlopes::Gaussian`), the views' value-conditioned bins', the
+    /// truth's relative standard error), worst channel; the 241-node prototype is printed.
     fn errors(
         views: &[f64],
         azimuths: &[f64],
     ) -> Vec<(&'static str, bool, f64, f64, f64, f64, f64)> {
         let base = crate::eval::test_materials::preset("cobblestones");
+        let mut gaussian = base.clone();
+        gaussian.filtering.transfer_slopes = TransferSlopes::Gaussian;
         let mut rows = vec![];
         for (name, img, skewed) in test_images::all() {
-            let image = ImageDriver::new(test_images::SIDE, test_images::SIDE, &img).unwrap();
-            let p = Evaluator::with_image(&base, Some(Arc::new(image)), None).unwrap();
+            let image =
+                Arc::new(ImageDriver::new(test_images::SIDE, test_images::SIDE, &img).unwrap());
+            let p = Evaluator::with_image(&base, Some(image.clone()), None).unwrap();
+            let pg = Evaluator::with_image(&gaussian, Some(image), None).unwrap();
             for &view in views {
                 for &azimuth in azimuths {
                     let cfg = FootprintQuery::far(
@@ -438,16 +444,18 @@ mod image_tests {
                             .map(|k| (v[k] - t.mean[k]) / t.mean[k])
                             .fold(0.0f64, |a, e| if e.abs() > a.abs() { e } else { a })
                     };
-                    let model = err(p.filtered(&cfg));
-                    let mixture = err(p.filtered_mixture(&cfg).unwrap());
+                    let model = err(pg.filtered(&cfg));
+                    let mixture = err(p.filtered(&cfg));
+                    let prototype = err(p.filtered_mixture(&cfg).unwrap());
                     let se = (0..3)
                         .map(|k| t.std_error[k] / t.mean[k])
                         .fold(0.0, f64::max);
                     eprintln!(
-                        "{name:<18} view {view:>2}° light 30°/{azimuth:>3}°: model {:+.2}%, \
-                         conditioned {:+.2}% (s.e. {:.2}%)",
+                        "{name:<18} view {view:>2}° light 30°/{azimuth:>3}°: one Gaussian \
+                         {:+.2}%, conditioned bins {:+.2}% (prototype {:+.2}%; s.e. {:.2}%)",
                         100.0 * model,
                         100.0 * mixture,
+                        100.0 * prototype,
                         100.0 * se
                     );
                     rows.push((name, skewed, view, azimuth, model, mixture, se));

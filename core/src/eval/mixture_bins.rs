@@ -47,16 +47,25 @@ pub struct BinMoments {
 
 impl Evaluator {
     /// [`BinMoments`] of the quantiles [lo, hi] of N(mean, std²), on [`BIN_SAMPLES`] midpoints in u.
+    /// For an image's value-conditioned slopes ([`Evaluator::image_slopes`]) N(mean, std²) is the
+    /// footprint in the image's Gaussian space: a point at G has the value `T⁻¹(G)`, `g′ = 1` and
+    /// `E[g′²]` its slope scale `s²` (normalized over the footprint by [`Evaluator::filtered_bins`]).
     pub fn bin_moments(&self, mean: f64, std: f64, lo: f64, hi: f64) -> BinMoments {
         let g = &self.material.heights.transfer;
         let (mut d1, mut d2, mut color) = (0.0, 0.0, [0.0; 3]);
         let k = 1.0 / BIN_SAMPLES as f64;
         for q in 0..BIN_SAMPLES {
             let u = lo + (hi - lo) * (q as f64 + 0.5) * k;
-            let f = mean + std * norm_quantile(u);
-            let gd = g.derivative(f);
+            let x = mean + std * norm_quantile(u);
+            let (f, gd, gd2) = match &self.image_slopes {
+                Some(t) => (t.value_at_gauss(x), 1.0, t.scale_at_gauss(x)),
+                None => {
+                    let gd = g.derivative(x);
+                    (x, gd, gd * gd)
+                }
+            };
             d1 += gd * k;
-            d2 += gd * gd * k;
+            d2 += gd2 * k;
             let c = self.color_at(f);
             for ch in 0..3 {
                 color[ch] += c[ch] * k;
@@ -87,7 +96,32 @@ impl Evaluator {
             TransferFunction::Curve(c) => c.points.iter().map(|p| p[0]).collect(),
             TransferFunction::Identity => Vec::new(),
         };
-        let edges = mixture_edges(&knots, d.mean, d.std);
+        // An image's bins live in its Gaussian space (the colour's input distribution there).
+        let (mean, std) = if self.image_slopes.is_some() {
+            self.color.input_distribution(loc, self.global_height)
+        } else {
+            (d.mean, d.std)
+        };
+        let edges = mixture_edges(&knots, mean, std);
+        let mut bins: Vec<(f64, f64, BinMoments)> = edges
+            .windows(2)
+            .filter(|e| e[1] > e[0])
+            .map(|e| (e[0], e[1], self.bin_moments(mean, std, e[0], e[1])))
+            .collect();
+        if self.image_slopes.is_some() {
+            // The image's slope scale splits the footprint's slope covariance among its values:
+            // normalized so that their mean is 1 (the pyramid's total stays).
+            let total: f64 = bins
+                .iter()
+                .map(|(lo, hi, b)| (hi - lo) * b.rms_deriv * b.rms_deriv)
+                .sum();
+            if total > 0.0 {
+                let k = total.sqrt().recip();
+                for (_, _, b) in &mut bins {
+                    b.rms_deriv *= k;
+                }
+            }
+        }
         let sigma_h = self.surface.sigma_h;
         let sun_lit = wi.z > 0.0 && cfg.wi.z > 0.0;
         let b = &m.brdf;
@@ -96,12 +130,7 @@ impl Evaluator {
         let points = bin_slope_points(m.filtering.slope_points, m.terms.slope.is_some());
         let (mut above_o, mut above) = (0.0, 0.0);
         let (mut num, mut den) = ([0.0f64; 3], 0.0f64);
-        for e in edges.windows(2).rev() {
-            let (lo, hi) = (e[0], e[1]);
-            if !(hi > lo) {
-                continue;
-            }
-            let bin = self.bin_moments(d.mean, d.std, lo, hi);
+        for &(lo, hi, bin) in bins.iter().rev() {
             let mean = d.mean_gradient * (sigma_h * bin.mean_deriv);
             let cov = d.gradient_cov.scaled(sigma_h * bin.rms_deriv);
             let ms = G2::from_directions(wo, wi, &cov, m.filtering.correlation);

@@ -17,6 +17,7 @@
 use crate::driver::histogram::ImageHistogram;
 use crate::material::transfer::TransferFunction;
 use crate::material::{ColorModel, ColorSource, Driver, Material};
+use crate::microfacet::height_mixture::TransferSlopes;
 use crate::scene::shape::Shape;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -158,12 +159,12 @@ impl FeatureSet {
     #[must_use]
     pub fn normalized(self) -> FeatureSet {
         let relief = self.contains(Feature::Relief);
-        let mixture = relief
-            && self.contains(Feature::TransferCurve)
-            && self.contains(Feature::TransferMixture);
         let histogram = self.contains(Feature::ImageHistogram)
             && self.contains(Feature::ImageDriver)
             && (self.contains(Feature::DriverColor) || self.contains(Feature::HeightColor));
+        let mixture = relief
+            && (self.contains(Feature::TransferCurve) || histogram)
+            && self.contains(Feature::TransferMixture);
         self.with(Feature::Shadows, relief && self.contains(Feature::Shadows))
             .with(Feature::TransferMixture, mixture)
             .with(Feature::ImageHistogram, histogram)
@@ -269,12 +270,16 @@ impl FeatureSet {
                     }
                     Feature::TransferCurve => "the height transfer function is the identity",
                     Feature::TransferMixture => {
-                        if !matches!(m.heights.transfer, TransferFunction::Curve(_)) {
-                            "the identity transfer keeps the slopes one Gaussian"
-                        } else if m.heights.sigma_h <= 0.0 {
+                        let image = matches!(m.driver, Driver::Image { .. });
+                        let curve = matches!(m.heights.transfer, TransferFunction::Curve(_));
+                        if m.heights.sigma_h <= 0.0 {
                             "sigma_h is 0: no slopes to mix"
-                        } else {
+                        } else if m.filtering.transfer_slopes == TransferSlopes::Gaussian {
                             "filtering.transfer_slopes is Gaussian (the papers' model)"
+                        } else if image && !curve {
+                            "the image's value-conditioned slopes need its histogram (filtering.image_histogram Preserving, a gradient colour map of its value)"
+                        } else {
+                            "the identity transfer keeps the noise's slopes one Gaussian (its value and gradient are independent)"
                         }
                     }
                     Feature::Relief => "sigma_h is 0: the surface is flat",

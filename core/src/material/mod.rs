@@ -253,12 +253,26 @@ impl Default for Material {
 
 impl Material {
     /// Whether the filtered view models the slopes as a mixture over the driver's value
-    /// ([`crate::microfacet::height_mixture`]): a transfer curve on relief, with
-    /// [`TransferSlopes::Mixture`] (under the identity the mixture is one Gaussian).
+    /// ([`crate::microfacet::height_mixture`]), with [`TransferSlopes::Mixture`] on relief: under a
+    /// transfer curve (g′ depends on the value), or for an image driver whose slopes depend on its
+    /// value ([`Material::image_slope_mixture`]). A noise driver under the identity keeps one
+    /// Gaussian: its value and gradient are independent, and the mixture would be that Gaussian.
     pub fn transfer_mixture(&self) -> bool {
         self.heights.sigma_h > 0.0
-            && matches!(self.heights.transfer, TransferFunction::Curve(_))
             && self.filtering.transfer_slopes == TransferSlopes::Mixture
+            && (matches!(self.heights.transfer, TransferFunction::Curve(_))
+                || self.image_slope_mixture())
+    }
+
+    /// Whether the mixture's bins carry an image's value-conditioned slopes
+    /// ([`crate::driver::conditional_slopes`]): an image driver that keeps its histogram (the
+    /// bins live in its Gaussian space), under the identity transfer, on relief, with
+    /// [`TransferSlopes::Mixture`].
+    pub fn image_slope_mixture(&self) -> bool {
+        self.heights.sigma_h > 0.0
+            && self.filtering.transfer_slopes == TransferSlopes::Mixture
+            && matches!(self.heights.transfer, TransferFunction::Identity)
+            && self.image_histogram()
     }
 
     /// Whether the filtered view keeps an image driver's histogram

@@ -10,7 +10,9 @@ struct BinMoments {
     color: vec3<f32>,
 }
 
-// Evaluator::bin_moments: mean and rms of g′ and the mean colour over the quantiles [lo, hi].
+// Evaluator::bin_moments: mean and rms of g′ and the mean colour over the quantiles [lo, hi]; with
+// an image's value-conditioned slopes (params.is_on) N(mean, sd²) is in its Gaussian space, a
+// point at x has the value T⁻¹(x), g′ = 1 and E[g′²] its slope scale s².
 fn bin_moments(mean: f32, sd: f32, lo: f32, hi: f32) -> BinMoments {
     var d1 = 0.0;
     var d2 = 0.0;
@@ -18,10 +20,19 @@ fn bin_moments(mean: f32, sd: f32, lo: f32, hi: f32) -> BinMoments {
     let k = 1.0 / f32(BIN_SAMPLES);
     for (var q = 0u; q < BIN_SAMPLES; q = q + 1u) {
         let u = lo + (hi - lo) * (f32(q) + 0.5) * k;
-        let f = mean + sd * norm_quantile(u);
-        let gd = transfer_eval(f).y;
+        let x = mean + sd * norm_quantile(u);
+        var f = x;
+        var gd = 1.0;
+        var gd2 = 1.0;
+        if (params.is_on == 1u) {
+            f = value_at_gauss(x);
+            gd2 = scale_at_gauss(x);
+        } else {
+            gd = transfer_eval(x).y;
+            gd2 = gd * gd;
+        }
         d1 = d1 + gd * k;
-        d2 = d2 + gd * gd * k;
+        d2 = d2 + gd2 * k;
         c = c + color_at(f) * k;
     }
     return BinMoments(d1, sqrt(max(d2, 0.0)), c);
@@ -31,7 +42,29 @@ fn bin_moments(mean: f32, sd: f32, lo: f32, hi: f32) -> BinMoments {
 // the macro frame.
 fn filtered_bins(loc: FootprintStats, wo_w: vec3<f32>, wi_w: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, sun_visible: f32) -> vec3<f32> {
     let d = loc.driver;
-    let n = mixture_edges(d.mean, d.std_dev);
+    // An image's bins live in its Gaussian space (the colour's input distribution there).
+    var ms = vec2<f32>(d.mean, d.std_dev);
+    if (params.is_on == 1u) {
+        ms = input_distribution(loc);
+    }
+    let n = mixture_edges(ms.x, ms.y);
+    // The image's slope scale splits the footprint's slope covariance among its values:
+    // normalized so that their mean is 1 (the pyramid's total stays).
+    var norm = 1.0;
+    if (params.is_on == 1u) {
+        var total = 0.0;
+        for (var j = 1u; j < n; j = j + 1u) {
+            let lo = mixture_edge_buf[j - 1u];
+            let hi = mixture_edge_buf[j];
+            if (hi > lo) {
+                let r = bin_moments(ms.x, ms.y, lo, hi).rms_deriv;
+                total = total + (hi - lo) * r * r;
+            }
+        }
+        if (total > 0.0) {
+            norm = 1.0 / sqrt(total);
+        }
+    }
     let sun_lit = wi.z > 0.0 && wi_w.z > 0.0;
     let kd = params.albedo * FRAC_1_PI;
     let sun = params.sun * sun_visible;
@@ -46,9 +79,9 @@ fn filtered_bins(loc: FootprintStats, wo_w: vec3<f32>, wi_w: vec3<f32>, wo: vec3
         if (!(hi > lo)) {
             continue;
         }
-        let bin = bin_moments(d.mean, d.std_dev, lo, hi);
+        let bin = bin_moments(ms.x, ms.y, lo, hi);
         let s_mean = d.mean_gradient * (params.sigma_h * bin.mean_deriv);
-        let scale = params.sigma_h * bin.rms_deriv;
+        let scale = params.sigma_h * bin.rms_deriv * norm;
         let cov = d.gradient_cov * (scale * scale);
         let ms = masking_shadowing(wo, wi, cov);
         let w1 = bin_masking(lo, hi, ms.lambda_o, above_o);
