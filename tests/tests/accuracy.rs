@@ -23,17 +23,14 @@ const VIEWS: [f64; 3] = [0.0, 60.0, 85.0];
 const LIGHTS: [(f64, f64); 3] = [(0.0, 0.0), (30.0, 0.0), (30.0, 180.0)];
 
 /// Open shortfalls of #17: (preset file, view, light angle, light azimuth, largest excess allowed),
-/// measured 2026-12-02 (the excess ×1.1). Cobblestones: the image's colour is correlated with its
-/// slopes and with grazing visibility (mortar at the stones' steep edges), which filtering with
-/// heights independent of slopes cannot say (docs/design.md). Snow under sky: the environment's
-/// share at 85°. (Terraces, 1.3–1.6% at 0° and 60° with the transfer mixture's 8 bins, met the
-/// goal once the mixture had 16: 0.6–0.9%.)
+/// measured 2026-12-03 (the excess ×1.1). Cobblestones at 85° with the light at the normal: the
+/// specular (+69% of itself, 12% of the light) of the value-conditioned slope mixture, not
+/// diagnosed further (its four other entries, 1.3–17%
+/// with one slope Gaussian, met the goal once the slopes were conditioned on the image's value,
+/// docs/design.md). Snow under sky: the environment's share at 85°. (Terraces, 1.3–1.6% at 0° and
+/// 60° with the transfer mixture's 8 bins, met the goal once the mixture had 16: 0.6–0.9%.)
 const KNOWN: &[(&str, f64, f64, f64, f64)] = &[
-    ("cobblestones.ron", 0.0, 0.0, 0.0, 0.0145),
-    ("cobblestones.ron", 60.0, 30.0, 180.0, 0.016),
-    ("cobblestones.ron", 85.0, 0.0, 0.0, 0.162),
-    ("cobblestones.ron", 85.0, 30.0, 0.0, 0.079),
-    ("cobblestones.ron", 85.0, 30.0, 180.0, 0.18),
+    ("cobblestones.ron", 85.0, 0.0, 0.0, 0.087),
     ("snow-under-sky.ron", 85.0, 0.0, 0.0, 0.057),
     ("snow-under-sky.ron", 85.0, 30.0, 0.0, 0.055),
     ("snow-under-sky.ron", 85.0, 30.0, 180.0, 0.060),
