@@ -666,7 +666,11 @@ fn transfer_model_note(ui: &mut Ui, m: &Material) {
     };
     ui.weak(note(
         Feature::TransferMixture,
-        "Slopes: mixture over the driver's value (a transfer curve on relief)",
+        if m.image_slope_mixture() {
+            "Slopes: mixture over the image's value (its slopes depend on its value)"
+        } else {
+            "Slopes: mixture over the driver's value (a transfer curve on relief)"
+        },
         "Slopes: one Gaussian",
     ));
     if matches!(m.driver, Driver::Image { .. }) {
@@ -714,7 +718,7 @@ fn filtering(ui: &mut Ui, f: &mut Filtering) -> bool {
             ui.selectable_value(&mut t, TransferSlopes::Gaussian, "Gaussian");
         })
         .response
-        .on_hover_text("Slopes under a transfer curve g: a mixture of Gaussians over bins of the driver's value f (given f the slopes are Gaussian with std σ_h·g'(f) times the driver's gradient std), with height-dependent masking (default), or one Gaussian of the same second moment [HNPN14 Eqs. 19–26]");
+        .on_hover_text("Slopes under a transfer curve g, or of an image driver: a mixture of Gaussians over bins of the driver's value f (given f the slopes are Gaussian with std σ_h·g'(f) times the driver's gradient std; for an image, times the square root of its own conditional E[|grad f|² given f] / E[|grad f|²], so flat tops and steep flanks get their own slopes), with height-dependent masking (default), or one Gaussian of the same second moment [HNPN14 Eqs. 19–26]");
     if t != f.transfer_slopes {
         f.transfer_slopes = t;
         changed = true;

@@ -5,7 +5,8 @@
 //! averaged over the visible slope distribution D_s [HNPN14 Sec. 5.2] jointly with the slope colour
 //! and environment irradiance ([`crate::eval::shading`]), and ρ̄_s the Beckmann lobe widened by the
 //! unresolved slopes ([`filtered_specular`], [HN12 Sec. 5.5]). Transfer functions enter through their
-//! moment tables [HNPN14 Eqs. 21–26]; under a transfer curve the slopes are by default a mixture
+//! moment tables [HNPN14 Eqs. 21–26]; under a transfer curve, and for an image driver whose slopes
+//! depend on its value ([`crate::driver::conditional_slopes`]), the slopes are by default a mixture
 //! over the driver's value instead of one Gaussian ([`crate::eval::mixture_bins`]).
 
 use crate::driver::field::DriverField;

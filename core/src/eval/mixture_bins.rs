@@ -1,5 +1,6 @@
-//! The filtered model under a transfer curve: the footprint's slopes as a mixture of Gaussians
-//! over bins of the driver's value, each with its colour, its visible-slope shading and
+//! The filtered model under a transfer curve, or for an image whose slopes depend on its value
+//! ([`crate::driver::conditional_slopes`]): the footprint's slopes as a mixture of Gaussians over
+//! bins of the driver's value, each with its colour, its visible-slope shading and
 //! height-dependent masking ([`crate::microfacet::height_mixture`]).
 //!
 //! Per bin b (quantiles [lo, hi] of the footprint's driver N(f̄, σ_f²), [`mixture_edges`]): the

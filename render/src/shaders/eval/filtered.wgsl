@@ -15,7 +15,8 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
     let wo = above_horizon(vec3<f32>(dot(wo_w, t), dot(wo_w, b), dot(wo_w, nbar)));
     let wi = vec3<f32>(dot(wi_w, t), dot(wi_w, b), dot(wi_w, nbar));
 //#if transfer_mixture
-    // A transfer curve: the slopes as the binned mixture (mix_points is 0 otherwise).
+    // A transfer curve, or an image's value-conditioned slopes: the binned mixture (mix_points is 0
+    // otherwise).
     if (params.mix_points > 0u) {
         return filtered_bins(loc, wo_w, wi_w, wo, wi, sun_visible);
     }
