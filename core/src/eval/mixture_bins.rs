@@ -21,6 +21,7 @@
 //! the moss, sponge and terraces presets: within 0.1%, 0.8% and 3.0% (terraces at 75°; a riser
 //! whose g′ runs from 0 to its peak inside one bin is still one Gaussian).
 
+use crate::driver::conditional_slopes::ImageSlopes;
 use crate::eval::query::FootprintStats;
 use crate::eval::shading::SlopeShading;
 use crate::eval::{Evaluator, FootprintQuery};
@@ -79,6 +80,19 @@ impl Evaluator {
         }
     }
 
+    /// `E_b[s²]` of an image's value-conditioned slopes ([`ImageSlopes`]) over the quantiles
+    /// [lo, hi] of N(mean, std²) in its Gaussian space, on the [`BIN_SAMPLES`] midpoints of
+    /// [`Evaluator::bin_moments`]: what the footprint's normalization needs, without the colour.
+    pub fn bin_slope_scale(t: &ImageSlopes, mean: f64, std: f64, lo: f64, hi: f64) -> f64 {
+        let k = 1.0 / BIN_SAMPLES as f64;
+        (0..BIN_SAMPLES)
+            .map(|q| {
+                let u = lo + (hi - lo) * (q as f64 + 0.5) * k;
+                t.scale_at_gauss(mean + std * norm_quantile(u)) * k
+            })
+            .sum()
+    }
+
     /// The filtered model with the footprint's slopes as the binned mixture (module docs), `wo`
     /// and `wi` in the frame of the footprint's mean normal (for Λ), `cfg`'s in the macro frame
     /// (for the slope averages, which live in world slope space), `sun_visible` the shadow ray's
@@ -109,12 +123,12 @@ impl Evaluator {
             .filter(|e| e[1] > e[0])
             .map(|e| (e[0], e[1], self.bin_moments(mean, std, e[0], e[1])))
             .collect();
-        if self.image_slopes.is_some() {
+        if let Some(t) = &self.image_slopes {
             // The image's slope scale splits the footprint's slope covariance among its values:
             // normalized so that their mean is 1 (the pyramid's total stays).
             let total: f64 = bins
                 .iter()
-                .map(|(lo, hi, b)| (hi - lo) * b.rms_deriv * b.rms_deriv)
+                .map(|(lo, hi, _)| (hi - lo) * Self::bin_slope_scale(t, mean, std, *lo, *hi))
                 .sum();
             if total > 0.0 {
                 let k = total.sqrt().recip();

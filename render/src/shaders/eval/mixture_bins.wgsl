@@ -38,6 +38,18 @@ fn bin_moments(mean: f32, sd: f32, lo: f32, hi: f32) -> BinMoments {
     return BinMoments(d1, sqrt(max(d2, 0.0)), c);
 }
 
+// Evaluator::bin_slope_scale: E_b[s²] of the image's value-conditioned slopes over the quantiles
+// [lo, hi] of N(mean, sd²) in its Gaussian space, on bin_moments' midpoints, without the colour.
+fn bin_slope_scale(mean: f32, sd: f32, lo: f32, hi: f32) -> f32 {
+    var s = 0.0;
+    let k = 1.0 / f32(BIN_SAMPLES);
+    for (var q = 0u; q < BIN_SAMPLES; q = q + 1u) {
+        let u = lo + (hi - lo) * (f32(q) + 0.5) * k;
+        s = s + scale_at_gauss(mean + sd * norm_quantile(u)) * k;
+    }
+    return s;
+}
+
 // Evaluator::filtered_bins: the binned mixture, wo/wi in the mean normal's frame, wo_w/wi_w in
 // the macro frame.
 fn filtered_bins(loc: FootprintStats, wo_w: vec3<f32>, wi_w: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, sun_visible: f32) -> vec3<f32> {
@@ -57,8 +69,7 @@ fn filtered_bins(loc: FootprintStats, wo_w: vec3<f32>, wi_w: vec3<f32>, wo: vec3
             let lo = mixture_edge_buf[j - 1u];
             let hi = mixture_edge_buf[j];
             if (hi > lo) {
-                let r = bin_moments(ms.x, ms.y, lo, hi).rms_deriv;
-                total = total + (hi - lo) * r * r;
+                total = total + (hi - lo) * bin_slope_scale(ms.x, ms.y, lo, hi);
             }
         }
         if (total > 0.0) {
