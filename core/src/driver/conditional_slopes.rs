@@ -103,14 +103,6 @@ impl ImageSlopes {
         }
     }
 
-    /// The table of an image driver's explicit surface.
-    pub fn of_image(image: &ImageDriver) -> Self {
-        Self::new(
-            &ConditionalSlopes::of_image(image),
-            &DriverHistogram::of_image(image),
-        )
-    }
-
     /// `s²` at Gaussian-space value g: linear between the rank bins' centres (constant beyond
     /// the first and last), so the views' bins see no jump at a bin edge.
     pub fn scale_at_gauss(&self, g: f64) -> f64 {

@@ -3,7 +3,7 @@
 //! live one per file beside this one.
 
 use crate::driver::DriverError;
-use crate::driver::conditional_slopes::ImageSlopes;
+use crate::driver::conditional_slopes::{ConditionalSlopes, ImageSlopes};
 use crate::driver::field::DriverField;
 use crate::driver::histogram::DriverHistogram;
 use crate::driver::image::ImageDriver;
@@ -72,6 +72,13 @@ impl Evaluator {
             p.material.image_histogram() == histogram
                 && (!histogram || p.material.driver == material.driver)
         });
+        // Built at most once, for the colour table and the image's slope table alike.
+        let image_histogram = std::cell::OnceCell::new();
+        let histogram_of = |t: &crate::driver::field::TiledImage| {
+            image_histogram
+                .get_or_init(|| DriverHistogram::of_image(&t.image))
+                .clone()
+        };
         let color = match previous {
             Some(p) if same_spec && same_histogram && p.material.color == material.color => {
                 p.color.clone()
@@ -81,7 +88,7 @@ impl Evaluator {
                     .driver
                     .image()
                     .filter(|_| histogram)
-                    .map(|t| DriverHistogram::of_image(&t.image));
+                    .map(histogram_of);
                 CompiledColor::new(&material.color, spec, h.as_ref())
             }
         };
@@ -95,7 +102,12 @@ impl Evaluator {
             (true, Some(t)) => previous
                 .filter(|p| p.material.driver == material.driver)
                 .and_then(|p| p.image_slopes.clone())
-                .or_else(|| Some(Arc::new(ImageSlopes::of_image(&t.image)))),
+                .or_else(|| {
+                    Some(Arc::new(ImageSlopes::new(
+                        &ConditionalSlopes::of_image(&t.image),
+                        &histogram_of(t),
+                    )))
+                }),
             _ => None,
         };
         let g = material.heights.transfer.moments(0.0, 1.0);
