@@ -731,7 +731,7 @@ fn filtering(ui: &mut Ui, f: &mut Filtering) -> bool {
             ui.selectable_value(&mut d, NoiseSlopes::Gaussian, "Gaussian");
         })
         .response
-        .on_hover_text("Density of the noise's unresolved slopes under the specular lobe: the sum of sinusoids' own (saddlepoint of its cumulant generating function, Σ ln I0; lighter tails than a Gaussian) or the Gaussian of the same covariance [HN12 Sec. 5.5]");
+        .on_hover_text("Density of the noise's unresolved slopes under the specular lobe: the sum of sinusoids' own (saddlepoint of its cumulant generating function, Σ ln I0; lighter tails than a Gaussian; a few Newton steps over the waves per pixel, most of what the filtered view costs over naive) or the Gaussian of the same covariance [HN12 Sec. 5.5]");
     if d != f.noise_slopes {
         f.noise_slopes = d;
         changed = true;
