@@ -6,6 +6,7 @@
 const SADDLEPOINT_ITERATIONS: u32 = 8u;
 const NEWTON_DECREMENT: f32 = 1e-11;
 const BACKTRACKS: u32 = 3u;
+const F_TOLERANCE: f32 = 2.5e-7;
 const MAX_LOG_RATIO: f32 = 4.0;
 const MIN_SIGMA0: f32 = 1e-3;
 const NEGLIGIBLE_TERM: f32 = 1e-9;
@@ -126,7 +127,7 @@ fn sinusoid_density_ratio(d: vec2<f32>, sigma0: f32, fp: vec3<f32>) -> f32 {
         for (var b = 0u; b <= BACKTRACKS; b = b + 1u) {
             let cand = tau - step * t;
             let oc = objective(s02, d, cand);
-            if (oc.f <= o.f) {
+            if (oc.f <= o.f + F_TOLERANCE * abs(o.f)) {
                 tau = cand;
                 o = oc;
                 moved = true;
