@@ -47,11 +47,11 @@ pub const NEWTON_DECREMENT: f64 = 1e-11;
 /// A step is taken when F rises by at most this fraction of |F| (more than f32's rounding of F,
 /// 6e-8 relative): near the minimum a full Newton step changes F by less than its rounding, and
 /// a strict `F(τ + step) ≤ F(τ)` on the GPU then compares rounding noise, fails, and spends
-/// [`BACKTRACKS`] + 1 evaluations for nothing (measured on the GPU before this tolerance: up to
-/// 27 evaluations for one pixel, 9–11 for the slowest of every 8 neighbouring pixels against 4–5
-/// on average; with it 2.4–3.1 on average and 2.9–4.2 for the slowest of 8: default preset,
-/// 128², 60°/80° × distance 6/40). F is convex, so a Newton step there is a sound one; far from the minimum F's
-/// decrease dwarfs the tolerance and the backtracking guards as before.
+/// [`BACKTRACKS`] + 1 evaluations for nothing. Measured on the GPU (default preset, 128²,
+/// 60°/80° × distance 6/40), evaluations per pixel before this tolerance: 4.3–5.1 on average,
+/// 6.6–11.3 for the slowest of every 8 neighbouring pixels, up to 27; with it 2.4–3.1 and
+/// 2.9–4.2. F is convex, so a Newton step there is a sound one; far from the minimum F's decrease
+/// dwarfs the tolerance and the backtracking guards as before.
 pub const F_TOLERANCE: f64 = 2.5e-7;
 
 /// Step halvings per Newton iteration.
