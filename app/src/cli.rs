@@ -111,6 +111,10 @@ pub enum Command {
         /// How the ray marches step and refine a crossing (the reference stays selectable).
         #[arg(long, value_enum, default_value_t = MarchArg::Fast)]
         march: MarchArg,
+        /// Side of the pixel blocks on whose means errors are also measured against the truth
+        /// with its own Monte Carlo noise taken out (`error` and `all`; 1 = per pixel).
+        #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=256))]
+        error_block: u32,
     },
     /// Time each mode's frame on the GPU adapter (medians of repeated frames) over presets × view
     /// angles × distances, against a "flat" reference (the same camera and colour with σ_h = 0: the

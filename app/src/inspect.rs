@@ -263,6 +263,7 @@ mod tests {
             distance: 6.0,
             shape: Shape::Plane,
             march: Default::default(),
+            error_block: 8,
         }
     }
 

@@ -227,6 +227,7 @@ fn run(cli: Cli) -> Result<()> {
             out,
             formats,
             march,
+            error_block,
         }) => {
             let shape = shape.shape(radius).map_err(UsageError)?;
             check_output(&out, mode == cli::RenderMode::All)?;
@@ -238,6 +239,7 @@ fn run(cli: Cli) -> Result<()> {
                 distance,
                 shape,
                 march: march.march(),
+                error_block,
             };
             render_cmd::render(&preset, view, mode, size, spp, &out, formats)?;
         }
@@ -322,6 +324,7 @@ fn run(cli: Cli) -> Result<()> {
                 distance: 6.0,
                 shape: shape.shape(2.0).map_err(anyhow::Error::msg)?,
                 march: lodestone_core::scene::march::March::default(),
+                error_block: 8,
             };
             let opts = inspect::Options {
                 view,

@@ -8,6 +8,7 @@ use lodestone_core::scene::direction::direction;
 use lodestone_core::scene::march::March;
 use lodestone_core::scene::shape::Shape;
 use lodestone_render::error_map::{abs_difference, error_stats, heat_map};
+use lodestone_render::truth_noise::{BlockErrors, SampleMoments, TruthEstimate};
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
 };
@@ -31,6 +32,9 @@ pub struct View {
     pub shape: Shape,
     /// How the marches refine a crossing.
     pub march: March,
+    /// Side of the pixel blocks on whose means errors against the truth are also measured with
+    /// its own noise taken out (`lodestone_render::truth_noise`).
+    pub error_block: u32,
 }
 
 impl View {
@@ -45,6 +49,7 @@ impl View {
             distance,
             shape: Shape::Plane,
             march: March::Fast,
+            error_block: 8,
         }
     }
 
@@ -133,24 +138,48 @@ pub fn render(
     let gm = GpuMaterial::new(r.context(), &prepared, scene.camera.target)?;
     let draw = |m: ViewMode| r.render(&gm, &scene, m, size, spp);
     let draw = |m: ViewMode| -> Result<LinearImage> { Ok(draw(m)?) };
+    // Ground truth with its per-pixel squared sums (its own noise).
+    let draw_truth = || -> Result<(LinearImage, SampleMoments)> {
+        let mut t = ViewTarget::new(&r, size.0, size.1)?;
+        r.draw(&mut t, &gm, &scene, ViewMode::Truth, spp);
+        Ok((t.read(&r)?, t.read_moments(&r)?))
+    };
+    // "beyond truth noise: RMSE …" for `img` against the truth, or why it is unknown.
+    let beyond_noise = |img: &LinearImage, truth: &LinearImage, moments: &SampleMoments| {
+        match TruthEstimate::new(truth, moments)
+            .and_then(|t| BlockErrors::new(img, &t, view.error_block))
+        {
+            Some(b) => {
+                let (lo, hi) = b.rmse_range(2.0);
+                format!(
+                    "beyond truth noise on {k}×{k} blocks: RMSE {:.5} ({lo:.5}–{hi:.5}), {:.0}% of blocks significant",
+                    b.rmse(),
+                    b.significant_fraction() * 100.0,
+                    k = view.error_block
+                )
+            }
+            None => "truth noise unknown (fewer than 2 rays per pixel)".to_string(),
+        }
+    };
     match mode {
         RenderMode::Naive => save(&draw(ViewMode::Naive)?, out)?,
         RenderMode::ViewIndependent => save(&draw(ViewMode::ViewIndependent)?, out)?,
         RenderMode::Filtered => save(&draw(ViewMode::Filtered)?, out)?,
         RenderMode::Truth => save(&draw(ViewMode::Truth)?, out)?,
         RenderMode::Error => {
-            let (f, t) = (draw(ViewMode::Filtered)?, draw(ViewMode::Truth)?);
+            let (f, (t, tm)) = (draw(ViewMode::Filtered)?, draw_truth()?);
             let s = error_stats(&f, &t);
             outln!(
-                "filtered vs truth: RMSE {:.5}, max {:.5} (legend 0 … {:.5})",
+                "filtered vs truth: RMSE {:.5}, max {:.5} (legend 0 … {:.5}); {}",
                 s.rmse,
                 s.max,
-                s.max
+                s.max,
+                beyond_noise(&f, &t, &tm)
             );
             save(&heat_map(&f, &t, s.max), out)?;
         }
         RenderMode::All => {
-            let truth = draw(ViewMode::Truth)?;
+            let (truth, moments) = draw_truth()?;
             let modes = [
                 ("naive", draw(ViewMode::Naive)?),
                 ("view_independent", draw(ViewMode::ViewIndependent)?),
@@ -166,7 +195,12 @@ pub fn render(
             let mut set = Vec::new();
             for (name, img) in &modes {
                 let s = error_stats(img, &truth);
-                outln!("{name:>16} vs truth: RMSE {:.5}, max {:.5}", s.rmse, s.max);
+                outln!(
+                    "{name:>16} vs truth: RMSE {:.5}, max {:.5}; {}",
+                    s.rmse,
+                    s.max,
+                    beyond_noise(img, &truth, &moments)
+                );
                 encoded_as(img, name, formats, &mut set)?;
                 set.push((
                     format!("error_{name}.png"),

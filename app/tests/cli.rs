@@ -376,9 +376,23 @@ fn report_writes_tables_and_charts() {
         // Four analytic methods and ground truth at 1 and 4 rays (16 is the reference itself).
         assert_eq!(methods.len(), 6, "{c}");
         for m in methods {
-            for k in ["rmse", "delta_e_mean", "delta_e_p95", "ms"] {
+            for k in [
+                "rmse",
+                "rmse_beyond_noise",
+                "delta_e_mean",
+                "delta_e_p95",
+                "ms",
+            ] {
                 assert!(m[k].as_f64().unwrap().is_finite(), "{m}");
             }
+            // The reference's noise taken out: never above the plain RMSE, inside its range.
+            let v = m["rmse_beyond_noise"].as_f64().unwrap();
+            let range = m["rmse_beyond_noise_range"].as_array().unwrap();
+            let (lo, hi) = (range[0].as_f64().unwrap(), range[1].as_f64().unwrap());
+            assert!(
+                v <= m["rmse"].as_f64().unwrap() + 1e-12 && lo <= v && v <= hi,
+                "{m}"
+            );
         }
         let rmse = |name: &str| {
             methods.iter().find(|m| m["method"] == name).unwrap()["rmse"]
@@ -391,7 +405,11 @@ fn report_writes_tables_and_charts() {
         );
     }
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
-    assert!(md.contains("| naive MIP |") && md.contains("ref. noise"));
+    assert!(
+        md.contains("| naive MIP |")
+            && md.contains("ref. noise")
+            && md.contains("RMSE beyond ref. noise")
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -3,7 +3,8 @@
 //! Lodestone's renderer on wgpu, with no UI: headless device setup, the WGSL mirrors of
 //! `lodestone-core`'s f32 functions (and the harness that checks them on the adapter), one
 //! accumulation target per view (naive MIP, view-independent, filtered, ground truth) with readback
-//! to linear f32 and 8-bit sRGB, and error heat maps.
+//! to linear f32 and 8-bit sRGB, and error heat maps (against the truth with its own noise taken
+//! out: `truth_noise`).
 
 pub mod compute;
 pub mod error_map;
@@ -14,6 +15,7 @@ pub mod gpu_types;
 pub mod renderer;
 pub mod shaders;
 pub mod specialize;
+pub mod truth_noise;
 
 pub use gpu::{GpuContext, GpuError};
 pub use renderer::{GpuMaterial, LinearImage, RenderError, Renderer, Scene, ViewMode, ViewTarget};

@@ -8,6 +8,7 @@ use crate::gpu_codes::{
 };
 use crate::gpu_types::{MaterialParams, ViewParams};
 use crate::specialize::{SpecializeError, view_source_for};
+use crate::truth_noise::SampleMoments;
 use glam::{DVec2, DVec3};
 use lodestone_core::driver::field::{DriverField, TiledImage};
 use lodestone_core::driver::noise::SumOfSines;
@@ -178,13 +179,15 @@ pub struct GpuMaterial {
     surface: Surface,
 }
 
-/// One view's render target: an accumulation buffer (linear RGB + sample count per pixel) and its
-/// own view parameters, so several views can be drawn in one submission without sharing state.
+/// One view's render target: an accumulation buffer (linear RGB + sample count per pixel), ground
+/// truth's sums of squared samples beside it, and its own view parameters, so several views can be
+/// drawn in one submission without sharing state.
 #[derive(Debug)]
 pub struct ViewTarget {
     width: u32,
     height: u32,
     accum: wgpu::Buffer,
+    moments: wgpu::Buffer,
     view: wgpu::Buffer,
     /// Ground-truth rays per pixel accumulated so far.
     pub samples: u32,
@@ -216,6 +219,12 @@ impl ViewTarget {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
+        let moments = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("truth moments"),
+            size: bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
         let view = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("view params"),
             size: std::mem::size_of::<ViewParams>() as u64,
@@ -226,6 +235,7 @@ impl ViewTarget {
             width,
             height,
             accum,
+            moments,
             view,
             samples: 0,
         })
@@ -243,8 +253,34 @@ impl ViewTarget {
 
     /// Read the target back (waits for the GPU).
     pub fn read(&self, renderer: &Renderer) -> Result<LinearImage, RenderError> {
+        Ok(LinearImage {
+            width: self.width,
+            height: self.height,
+            pixels: self.read_buffer(renderer, &self.accum)?,
+        })
+    }
+
+    /// Read ground truth's per-pixel sums of squared samples back (waits for the GPU): the
+    /// truth's own noise, with [`read`](Self::read)'s sums ([`TruthEstimate`]). Meaningless for
+    /// a target that holds an analytic mode.
+    ///
+    /// [`TruthEstimate`]: crate::truth_noise::TruthEstimate
+    pub fn read_moments(&self, renderer: &Renderer) -> Result<SampleMoments, RenderError> {
+        Ok(SampleMoments {
+            width: self.width,
+            height: self.height,
+            sum_sq: self.read_buffer(renderer, &self.moments)?,
+        })
+    }
+
+    /// Copy one of the target's per-pixel `vec4<f32>` buffers back.
+    fn read_buffer(
+        &self,
+        renderer: &Renderer,
+        buffer: &wgpu::Buffer,
+    ) -> Result<Vec<[f32; 4]>, RenderError> {
         let device = &renderer.ctx.device;
-        let size = u64::from(self.width) * u64::from(self.height) * 16;
+        let size = u64::from(self.width) * u64::from(self.height) * BYTES_PER_PIXEL;
         let readback = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
             size,
@@ -254,7 +290,7 @@ impl ViewTarget {
         let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("readback"),
         });
-        enc.copy_buffer_to_buffer(&self.accum, 0, &readback, 0, size);
+        enc.copy_buffer_to_buffer(buffer, 0, &readback, 0, size);
         renderer.ctx.queue.submit([enc.finish()]);
         let slice = readback.slice(..);
         let (tx, rx) = std::sync::mpsc::channel();
@@ -273,15 +309,10 @@ impl ViewTarget {
             .get_mapped_range()
             .map_err(|e| RenderError::Readback(format!("{e:?}")))?;
         let floats: &[f32] = bytemuck::cast_slice(&view);
-        let pixels = floats
+        Ok(floats
             .chunks_exact(4)
             .map(|c| [c[0], c[1], c[2], c[3]])
-            .collect();
-        Ok(LinearImage {
-            width: self.width,
-            height: self.height,
-            pixels,
-        })
+            .collect())
     }
 }
 
@@ -1059,6 +1090,10 @@ impl Renderer {
                     wgpu::BindGroupEntry {
                         binding: 3,
                         resource: target.view.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: target.moments.as_entire_binding(),
                     },
                 ],
             });

@@ -605,3 +605,75 @@ fn noise_slope_density_on_the_gpu_matches_core() {
         sums[1]
     );
 }
+
+/// Ground truth's squared sums (`ViewTarget::read_moments`) are the sums of the squares of the
+/// rays it accumulated: drawn one ray per pixel at a time, each ray's colour is the difference of
+/// consecutive sums, and its square is summed on the CPU (in f64) for comparison. A flat noise
+/// colour map seen at a grazing angle (its pipeline compiles in seconds), so pixels hold sub-pixel
+/// colour noise and horizon sky alike.
+#[test]
+fn truth_moments_are_the_sums_of_squared_rays() {
+    let Some(r) = renderer() else { return };
+    let p = Evaluator::new(&preset("colormapped-noise.ron")).unwrap();
+    let scene = Scene {
+        camera: Camera {
+            elevation_deg: 78.0,
+            azimuth_deg: 20.0,
+            distance: 4.0,
+            target: [0.3, -0.2],
+            fov_deg: 40.0,
+        },
+        light: direction(40f64.to_radians(), 2.0),
+        shape: Shape::Plane,
+    };
+    let gm = GpuMaterial::new(r.context(), &p, scene.camera.target).expect("fits");
+    let (w, h, n) = (24u32, 16u32, 6u32);
+    let mut target = lodestone_render::ViewTarget::new(&r, w, h).expect("target");
+    let mut prev = vec![[0.0f32; 4]; (w * h) as usize];
+    let mut want = vec![[0.0f64; 4]; (w * h) as usize];
+    for _ in 0..n {
+        r.draw(&mut target, &gm, &scene, ViewMode::Truth, 1);
+        let now = target.read(&r).expect("readback").pixels;
+        for (i, (a, b)) in now.iter().zip(&prev).enumerate() {
+            let c: [f64; 3] = [0, 1, 2].map(|k| f64::from(a[k]) - f64::from(b[k]));
+            let y = lodestone_render::truth_noise::luminance(c);
+            for k in 0..3 {
+                want[i][k] += c[k] * c[k];
+            }
+            want[i][3] += y * y;
+        }
+        prev = now;
+    }
+    let got = target.read_moments(&r).expect("readback");
+    assert_eq!((got.width, got.height), (w, h));
+    let mut varied = 0;
+    for (i, (g, wnt)) in got.sum_sq.iter().zip(&want).enumerate() {
+        for k in 0..4 {
+            let tol = 1e-4 * (1.0 + wnt[k]);
+            assert!(
+                (f64::from(g[k]) - wnt[k]).abs() <= tol,
+                "pixel {i} component {k}: GPU {} vs rays {}",
+                g[k],
+                wnt[k]
+            );
+        }
+        // Count pixels whose rays differed, so the test sees noise and not only constant pixels.
+        let mean = f64::from(prev[i][1]) / f64::from(n);
+        if wnt[1] / f64::from(n) - mean * mean > 1e-6 {
+            varied += 1;
+        }
+    }
+    assert!(
+        varied > (w * h) as usize / 4,
+        "{varied} pixels with ray noise"
+    );
+    // A new accumulation starts its squares afresh too.
+    target.reset();
+    r.draw(&mut target, &gm, &scene, ViewMode::Truth, 1);
+    let one = target.read(&r).expect("readback");
+    let sq = target.read_moments(&r).expect("readback");
+    for (a, q) in one.pixels.iter().zip(&sq.sum_sq) {
+        let (q, a) = (f64::from(q[0]), f64::from(a[0]));
+        assert!((q - a * a).abs() <= 1e-5 * (1.0 + q), "{q} vs {a}²");
+    }
+}

@@ -124,12 +124,14 @@ impl EditorApp {
                     && (t.frame.image.width, t.frame.image.height)
                         == (s.frame.image.width, s.frame.image.height)
             }) {
-                use lodestone_render::error_map::{abs_difference, error_heat};
-                let heat = error_heat(
+                use lodestone_render::error_map::abs_difference;
+                let heat = super::frames::error_map(
                     &s.frame.image,
-                    &t.frame.image,
+                    &t.frame,
+                    self.view.error_block.max(1),
                     f64::from(self.view.error_scale),
-                );
+                )
+                .heat;
                 let png = dir.join(format!("error_{name}.png"));
                 heat.to_srgb8()
                     .save(&png)

@@ -1,9 +1,11 @@
 //! The render worker's side of the window: requests for what the views need, frames uploaded as
 //! textures as they arrive, and error heat maps against the ground truth.
 
-use super::worker::{Event, Request};
+use super::worker::{Event, Frame, Request};
 use super::{DeviceStatus, EditorApp, ErrorShown, Shown};
-use lodestone_render::ViewMode;
+use lodestone_render::error_map::{error_heat, error_stats, heat_gradient};
+use lodestone_render::truth_noise::{BlockErrors, TruthEstimate};
+use lodestone_render::{LinearImage, ViewMode};
 use std::sync::Arc;
 
 impl EditorApp {
@@ -60,6 +62,7 @@ impl EditorApp {
             return;
         };
         let tf = &truth.frame;
+        let (block, scale) = (self.view.error_block.max(1), self.view.error_scale);
         for (mode, s) in &self.shown {
             if *mode == ViewMode::Truth {
                 continue;
@@ -68,17 +71,18 @@ impl EditorApp {
             if (f.image.width, f.image.height) != (tf.image.width, tf.image.height) {
                 continue;
             }
-            let from = (f.generation, tf.generation, tf.samples);
+            let from = (
+                f.generation,
+                tf.generation,
+                tf.samples,
+                block,
+                scale.to_bits(),
+            );
             if self.errors.get(mode).is_some_and(|e| e.from == from) {
                 continue;
             }
-            let heat = lodestone_render::error_map::error_heat(
-                &f.image,
-                &tf.image,
-                f64::from(self.view.error_scale),
-            );
-            let stats = lodestone_render::error_map::error_stats(&f.image, &tf.image);
-            let img = heat.to_srgb8();
+            let map = error_map(&f.image, tf, block, f64::from(scale));
+            let img = map.heat.to_srgb8();
             let color = egui::ColorImage::from_rgba_unmultiplied(
                 [img.width() as usize, img.height() as usize],
                 img.as_raw(),
@@ -86,7 +90,7 @@ impl EditorApp {
             match self.errors.get_mut(mode) {
                 Some(e) => {
                     e.texture.set(color, egui::TextureOptions::LINEAR);
-                    e.stats = stats;
+                    e.summary = map.summary;
                     e.from = from;
                 }
                 None => {
@@ -99,7 +103,7 @@ impl EditorApp {
                         *mode,
                         ErrorShown {
                             texture,
-                            stats,
+                            summary: map.summary,
                             from,
                         },
                     );
@@ -147,4 +151,54 @@ impl EditorApp {
         self.worker.request(req.clone());
         self.last_request = Some((self.doc.material.clone(), req));
     }
+}
+
+/// One mode's difference from the ground truth as the editor shows it.
+pub(super) struct ErrorMap {
+    /// The heat map (linear RGB, the view's size).
+    pub heat: LinearImage,
+    /// Its numbers.
+    pub summary: ErrorSummary,
+}
+
+/// The numbers beside an error map.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct ErrorSummary {
+    /// RMSE per pixel as measured, the truth's own noise included.
+    pub rmse_raw: f64,
+    /// Largest per-pixel error (max over channels).
+    pub max: f64,
+    /// Block side of the noise-aware numbers, in view pixels.
+    pub block: u32,
+    /// RMSE of the block means beyond the truth's noise, with its range for ±2 standard errors
+    /// ([`BlockErrors::rmse`]); `None` while the truth has fewer than two rays per pixel.
+    pub beyond_noise: Option<(f64, (f64, f64))>,
+    /// Fraction of the view in blocks whose difference is significant
+    /// ([`BlockErrors::significant_fraction`]).
+    pub significant: Option<f64>,
+}
+
+/// `image` against the ground-truth frame `truth` (same size): heat of the `block × block` means'
+/// difference (`scale` at the top), blocks within the truth's noise in grey
+/// ([`BlockErrors::heat`]); while the truth's noise is unknown (one ray per pixel, or no
+/// moments), the per-pixel |image − truth| map.
+pub(super) fn error_map(image: &LinearImage, truth: &Frame, block: u32, scale: f64) -> ErrorMap {
+    let raw = error_stats(image, &truth.image);
+    let blocks = truth
+        .moments
+        .as_deref()
+        .and_then(|m| TruthEstimate::new(&truth.image, m))
+        .and_then(|t| BlockErrors::new(image, &t, block));
+    let summary = ErrorSummary {
+        rmse_raw: raw.rmse,
+        max: raw.max,
+        block,
+        beyond_noise: blocks.as_ref().map(|b| (b.rmse(), b.rmse_range(2.0))),
+        significant: blocks.as_ref().map(BlockErrors::significant_fraction),
+    };
+    let heat = match &blocks {
+        Some(b) => b.heat(image.width, image.height, &heat_gradient(), scale),
+        None => error_heat(image, &truth.image, scale),
+    };
+    ErrorMap { heat, summary }
 }

@@ -34,7 +34,6 @@ use files::recover;
 use inspector::Inspector;
 use lodestone_core::material::{Driver, Material};
 use lodestone_render::ViewMode;
-use lodestone_render::error_map::ErrorStats;
 use plots::AnglePlots;
 use serde::{Deserialize, Serialize};
 use std::collections::{HashMap, VecDeque};
@@ -101,9 +100,10 @@ struct Shown {
 /// The error heat map of one mode against ground truth, uploaded.
 struct ErrorShown {
     texture: egui::TextureHandle,
-    stats: ErrorStats,
-    /// Generations of the two frames it was made from.
-    from: (u64, u64, u32),
+    summary: frames::ErrorSummary,
+    /// Generations of the two frames it was made from, the truth's rays, the block size and the
+    /// heat scale's bits.
+    from: (u64, u64, u32, u32, u32),
 }
 
 /// A message in the status bar.

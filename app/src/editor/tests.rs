@@ -300,7 +300,14 @@ fn error_view_toggles_and_window_snapshots() {
         .errors
         .get(&ViewMode::Filtered)
         .expect("filtered error map");
-    assert!(e.stats.rmse.is_finite() && f.stats.rmse.is_finite());
+    assert!(e.summary.rmse_raw.is_finite() && f.summary.rmse_raw.is_finite());
+    // #18: on block means with the truth's noise taken out the filtered view ranks ahead of naive,
+    // as the far-patch means do at this angle (per pixel, the truth's glints made naive look
+    // better: 0.144 against 0.151 at 80°, 160×240, 32 rays).
+    let (Some((en, _)), Some((ef, _))) = (e.summary.beyond_noise, f.summary.beyond_noise) else {
+        panic!("the truth's noise is known at 64 rays per pixel");
+    };
+    assert!(ef < en, "filtered {ef} against naive {en}");
     window_snapshot(&mut h, "editor_grazing_errors");
     h.get_by_label("Error maps").click();
     h.step();

@@ -80,6 +80,8 @@ pub struct ViewState {
     pub show_error: bool,
     /// Error that maps to the top of the heat scale (linear RGB units).
     pub error_scale: f32,
+    /// Side of the pixel blocks whose means the error maps compare (1 = per pixel).
+    pub error_block: u32,
     /// A/B swipe inside one viewport instead of three viewports.
     pub ab: Option<AbSwipe>,
     /// Ground-truth rays per pixel to accumulate.
@@ -109,6 +111,7 @@ impl Default for ViewState {
             baseline: Mode::Naive,
             show_error: false,
             error_scale: 0.1,
+            error_block: 8,
             ab: None,
             truth_spp: 64,
             max_scale: 1.0,

@@ -200,7 +200,7 @@ impl EditorApp {
                         self.toggle_sweep(&ctx);
                     }
                     ui.checkbox(&mut self.view.show_error, "Error maps")
-                        .on_hover_text("Per-pixel |mode − ground truth|, max over RGB, as a heat map (E)");
+                        .on_hover_text("|mode − ground truth| on block means, max over RGB, as a heat map; blocks whose difference is within the truth's own Monte Carlo noise (under 2 standard errors) are grey (E)");
                     if self.view.show_error {
                         ui.add(
                             egui::Slider::new(&mut self.view.error_scale, 0.005..=1.0)
@@ -208,6 +208,19 @@ impl EditorApp {
                                 .text("Error scale"),
                         )
                         .on_hover_text("Error at the top of the heat scale (linear RGB)");
+                        egui::ComboBox::from_label("Error block")
+                            .selected_text(format!("{0}×{0}", self.view.error_block))
+                            .show_ui(ui, |ui| {
+                                for b in [1u32, 2, 4, 8, 16, 32] {
+                                    ui.selectable_value(
+                                        &mut self.view.error_block,
+                                        b,
+                                        format!("{b}×{b}"),
+                                    );
+                                }
+                            })
+                            .response
+                            .on_hover_text("Pixels per block whose means are compared (1×1: per pixel). Over a block the micro-geometry's own realisation averages out while a bias stays, and the truth's noise shrinks; the RMSE shown is what remains once that noise is taken out");
                     }
                 });
             });
@@ -317,9 +330,7 @@ impl EditorApp {
         let img = Rect::from_min_max(col.min + Vec2::new(0.0, LABEL_H), col.max);
         let show_error = self.view.show_error && rm != ViewMode::Truth;
         let extra = if show_error {
-            self.errors
-                .get(&rm)
-                .map(|e| format!("RMSE {:.4}  max {:.3}", e.stats.rmse, e.stats.max))
+            None
         } else if rm == ViewMode::Truth {
             self.shown
                 .get(&rm)
@@ -398,6 +409,9 @@ impl EditorApp {
         }
         if show_error {
             self.legend(ui, img);
+            if let Some(e) = self.errors.get(&rm) {
+                error_summary(ui, img, &e.summary);
+            }
         }
         self.interact_camera(ui, img, ui.scope_id().with(("view", mode)), mode.label());
     }
@@ -434,8 +448,15 @@ impl EditorApp {
             r.right_bottom() + Vec2::new(0.0, 1.0),
             egui::Align2::RIGHT_TOP,
             format!("{:.3}", self.view.error_scale),
-            font,
+            font.clone(),
             Color32::WHITE,
+        );
+        ui.painter().text(
+            r.right_center() + Vec2::new(8.0, 0.0),
+            egui::Align2::LEFT_CENTER,
+            "grey: within the truth's noise",
+            font,
+            Color32::from_gray(170),
         );
     }
 
@@ -514,4 +535,37 @@ fn px(size: Vec2, ppp: f32) -> [u32; 2] {
         (size.x * ppp).round().max(1.0) as u32,
         (size.y * ppp).round().max(1.0) as u32,
     ]
+}
+
+/// The error map's numbers, over the top left of its image: the RMSE beyond the truth's noise with
+/// its range, the share of significant blocks, and the raw per-pixel RMSE and max.
+fn error_summary(ui: &Ui, img: Rect, e: &super::frames::ErrorSummary) {
+    let mut lines = Vec::new();
+    match (e.beyond_noise, e.significant) {
+        (Some((rmse, (lo, hi))), Some(sig)) => {
+            lines.push(format!(
+                "RMSE beyond truth noise {rmse:.4} ({lo:.4}–{hi:.4})"
+            ));
+            lines.push(format!(
+                "{:.0}% of {b}×{b} blocks significant",
+                sig * 100.0,
+                b = e.block
+            ));
+        }
+        _ => lines.push("truth noise unknown until 2 rays per pixel".to_string()),
+    }
+    lines.push(format!(
+        "per pixel: RMSE {:.4}, max {:.3}",
+        e.rmse_raw, e.max
+    ));
+    let font = egui::FontId::proportional(12.0);
+    let painter = ui.painter_at(img);
+    let mut y = img.top() + 4.0;
+    for line in lines {
+        let galley = painter.layout_no_wrap(line, font.clone(), Color32::WHITE);
+        let r = Rect::from_min_size(Pos2::new(img.left() + 4.0, y), galley.size()).expand(2.0);
+        painter.rect_filled(r, 2.0, Color32::from_black_alpha(160));
+        painter.galley(Pos2::new(img.left() + 4.0, y), galley, Color32::WHITE);
+        y += r.height();
+    }
 }

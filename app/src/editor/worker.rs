@@ -16,6 +16,7 @@ use lodestone_core::driver::image::ImageDriver;
 use lodestone_core::eval::Evaluator;
 use lodestone_core::material::Material;
 use lodestone_core::math::sh::Sh9;
+use lodestone_render::truth_noise::SampleMoments;
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
 };
@@ -57,6 +58,8 @@ pub struct Frame {
     pub image: Arc<LinearImage>,
     /// Ground-truth rays per pixel in it (0 for analytic modes).
     pub samples: u32,
+    /// Ground truth's per-pixel sums of squared rays (its own noise; `None` for analytic modes).
+    pub moments: Option<Arc<SampleMoments>>,
     /// GPU time of the pass that produced it (for truth: of the last ray per pixel).
     pub pass_time: Duration,
     /// Resolution as a fraction of the full view size.
@@ -365,6 +368,7 @@ impl State {
                             mode,
                             image: Arc::new(image),
                             samples: 0,
+                            moments: None,
                             pass_time: dt,
                             scale,
                         }));
@@ -421,12 +425,16 @@ impl State {
             let done = target.samples >= req.truth_spp;
             // Read back at most ~8 times a second (and always at the end): readback costs a copy.
             if done || last_sent.elapsed() > Duration::from_millis(120) || target.samples <= 4 {
-                match target.read(&self.renderer) {
-                    Ok(image) => send(Event::Frame(Frame {
+                let read = target
+                    .read(&self.renderer)
+                    .and_then(|image| Ok((image, target.read_moments(&self.renderer)?)));
+                match read {
+                    Ok((image, moments)) => send(Event::Frame(Frame {
                         generation: req.generation,
                         mode: ViewMode::Truth,
                         image: Arc::new(image),
                         samples: target.samples,
+                        moments: Some(Arc::new(moments)),
                         pass_time: dt,
                         scale,
                     })),

@@ -5,6 +5,10 @@
 // pixel per frame; alpha counts samples).
 
 @group(0) @binding(2) var<storage, read_write> accum: array<vec4<f32>>;
+// Ground truth's per-pixel sums of squared samples (r², g², b², Y² with Y the Rec. 709 luminance),
+// beside accum's sums, so the truth's own Monte Carlo noise is known per pixel
+// (render/src/truth_noise.rs). Written by ground truth only.
+@group(0) @binding(4) var<storage, read_write> moments: array<vec4<f32>>;
 
 const PIXEL_SIGMA_DEFAULT: f32 = 0.5;
 
@@ -104,4 +108,7 @@ fn view_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invoc
 //#endif
     let prev = select(vec4<f32>(0.0), accum[idx], s > 0u);
     accum[idx] = prev + vec4<f32>(c, 1.0);
+    let y = dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
+    let prev2 = select(vec4<f32>(0.0), moments[idx], s > 0u);
+    moments[idx] = prev2 + vec4<f32>(c * c, y * y);
 }
