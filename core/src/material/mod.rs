@@ -17,6 +17,7 @@ pub mod color_terms;
 pub mod colormap;
 pub mod environment;
 pub mod features;
+pub mod merl;
 pub mod preconvolved;
 pub mod slope_color;
 pub mod table_slope;
