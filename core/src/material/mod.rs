@@ -18,6 +18,7 @@ pub mod colormap;
 pub mod environment;
 pub mod features;
 pub mod merl;
+pub mod merl_fit;
 pub mod preconvolved;
 pub mod slope_color;
 pub mod table_slope;
