@@ -7,7 +7,9 @@ use lodestone_core::scene::camera::Camera;
 use lodestone_core::scene::direction::direction;
 use lodestone_core::scene::march::March;
 use lodestone_core::scene::shape::Shape;
-use lodestone_render::error_map::{abs_difference, error_stats, heat_map};
+use lodestone_render::error_map::{
+    abs_difference, error_stats, heat_gradient, heat_map, with_legend,
+};
 use lodestone_render::truth_noise::{BlockErrors, SampleMoments, TruthEstimate};
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
@@ -185,15 +187,26 @@ pub fn render(
                 ("view_independent", draw(ViewMode::ViewIndependent)?),
                 ("filtered", draw(ViewMode::Filtered)?),
             ];
-            // One legend for every error map: the largest error of any mode.
+            // The error maps compare block means against the truth with its noise taken out
+            // (blocks within the noise grey), as the editor does; per pixel while the truth's
+            // noise is unknown (one ray). One legend for every map: the largest error of any mode.
+            let estimate = TruthEstimate::new(&truth, &moments);
+            let blocks: Vec<Option<BlockErrors>> = modes
+                .iter()
+                .map(|(_, i)| estimate.and_then(|t| BlockErrors::new(i, &t, view.error_block)))
+                .collect();
             let scale = modes
                 .iter()
-                .map(|(_, i)| error_stats(i, &truth).max)
+                .zip(&blocks)
+                .map(|((_, i), b)| match b {
+                    Some(b) => b.blocks.iter().map(|k| k.max_abs()).fold(0.0, f64::max),
+                    None => error_stats(i, &truth).max,
+                })
                 .fold(0.0, f64::max);
             // Every file is encoded first and the set written at once (staged, then renamed):
             // an interrupted run leaves the previous set, never a mix.
             let mut set = Vec::new();
-            for (name, img) in &modes {
+            for ((name, img), block) in modes.iter().zip(&blocks) {
                 let s = error_stats(img, &truth);
                 outln!(
                     "{name:>16} vs truth: RMSE {:.5}, max {:.5}; {}",
@@ -202,10 +215,11 @@ pub fn render(
                     beyond_noise(img, &truth, &moments)
                 );
                 encoded_as(img, name, formats, &mut set)?;
-                set.push((
-                    format!("error_{name}.png"),
-                    encode(&heat_map(img, &truth, scale), "png")?,
-                ));
+                let heat = match block {
+                    Some(b) => with_legend(b.heat(img.width, img.height, &heat_gradient(), scale)),
+                    None => heat_map(img, &truth, scale),
+                };
+                set.push((format!("error_{name}.png"), encode(&heat, "png")?));
                 if formats != Formats::Png {
                     set.push((
                         format!("error_{name}.exr"),
@@ -214,7 +228,15 @@ pub fn render(
                 }
             }
             outln!(
-                "error maps share the legend 0 … {scale:.5} (linear RGB), truth {spp} rays/pixel"
+                "error maps ({}) share the legend 0 … {scale:.5} (linear RGB), truth {spp} rays/pixel",
+                if blocks.iter().all(Option::is_some) {
+                    format!(
+                        "means of {k}×{k} blocks, grey within the truth's noise",
+                        k = view.error_block
+                    )
+                } else {
+                    "per pixel".to_string()
+                }
             );
             encoded_as(&truth, "truth", formats, &mut set)?;
             crate::preset_io::write_set(out, &set)?;

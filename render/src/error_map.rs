@@ -108,19 +108,24 @@ pub fn error_heat(image: &LinearImage, reference: &LinearImage, scale: f64) -> L
 
 /// [`error_heat`] with a legend bar along the bottom (left 0, right `scale`).
 pub fn heat_map(image: &LinearImage, reference: &LinearImage, scale: f64) -> LinearImage {
+    with_legend(error_heat(image, reference, scale))
+}
+
+/// `heat` (a map in [`heat_gradient`]'s colours) with the gradient as a legend bar along the
+/// bottom, 1/16 of its height (at least 2 rows): left 0, right the map's top.
+pub fn with_legend(mut heat: LinearImage) -> LinearImage {
     let g = heat_gradient();
-    let mut out = error_heat(image, reference, scale);
-    let (w, h) = (out.width, out.height);
+    let (w, h) = (heat.width, heat.height);
     let bar = (h / 16).max(2);
     for _ in 0..bar {
         for x in 0..w {
             let c = g.sample(f64::from(x) / f64::from(w.max(2) - 1));
-            out.pixels
+            heat.pixels
                 .push([c[0] as f32, c[1] as f32, c[2] as f32, 1.0]);
         }
     }
-    out.height = h + bar;
-    out
+    heat.height = h + bar;
+    heat
 }
 
 #[cfg(test)]
