@@ -75,6 +75,24 @@ impl BaseBrdf {
         let d = gaussian2(slope_of(h) - slope_of(n), cov);
         self.specular * d / (4.0 * h.z.powi(4) * wo.z)
     }
+
+    /// The largest [`specular_with`](Self::specular_with) any facet gives the pair (ωo, ωi) with
+    /// no added covariance: the lobe at its peak (facet normal along the half vector),
+    /// `F0 / (2π σ_n0²) / (4 h_z⁴ ωo_z)`. What one ground-truth ray's specular term can reach, for
+    /// sampling rules that must not stop before rare glints had their chance to be seen
+    /// (`lodestone diagnose`). 0 when F0 = 0 or either direction is at or below the horizon;
+    /// σ_n0² is floored at 1e-14 as in [`gaussian2`], so it stays finite as σ_n0 → 0.
+    pub fn specular_peak(&self, wo: DVec3, wi: DVec3) -> f64 {
+        if !(self.specular > 0.0 && wo.z > 0.0 && wi.z > 0.0) {
+            return 0.0;
+        }
+        let h = (wo + wi).normalize();
+        if h.z <= 1e-9 {
+            return 0.0;
+        }
+        let v = (self.roughness * self.roughness).max(1e-14);
+        self.specular / (TAU * v) / (4.0 * h.z.powi(4) * wo.z)
+    }
 }
 
 /// Specular averaged over D_s, in world slope space with facet slopes `s ~ N(s̄, Σ)` each carrying
@@ -136,6 +154,40 @@ mod tests {
     use super::*;
     use crate::math::quadrature::gauss_hermite_normal;
     use crate::scene::direction::direction;
+
+    #[test]
+    fn specular_peak_bounds_every_facet_and_is_reached_at_the_half_vector() {
+        let b = BaseBrdf {
+            albedo: 0.5,
+            specular: 0.6,
+            roughness: 0.04,
+        };
+        for (tv, tl, az) in [(1.31, 0.52, 0.0), (0.2, 0.9, 2.5), (1.5, 1.5, 3.1)] {
+            let (wo, wi) = (direction(tv, 0.0), direction(tl, az));
+            let peak = b.specular_peak(wo, wi);
+            let h = (wo + wi).normalize();
+            let at_h = b.specular_with(h, wo, wi, SlopeCov::isotropic(0.0));
+            assert!((at_h - peak).abs() <= 1e-9 * peak, "{at_h} vs {peak}");
+            // Brute force over facet slopes around the half vector's.
+            for i in -20..=20 {
+                for j in -20..=20 {
+                    let s = slope_of(h) + DVec2::new(f64::from(i), f64::from(j)) * 0.01;
+                    let n = DVec3::new(-s.x, -s.y, 1.0).normalize();
+                    let v = b.specular_with(n, wo, wi, SlopeCov::isotropic(0.0));
+                    assert!(v <= peak * (1.0 + 1e-12), "{v} > {peak}");
+                }
+            }
+        }
+        assert_eq!(
+            b.specular_peak(direction(1.0, 0.0), direction(1.7, 0.0)),
+            0.0
+        );
+        let sharp = BaseBrdf {
+            roughness: 0.0,
+            ..b
+        };
+        assert!(sharp.specular_peak(DVec3::Z, DVec3::Z).is_finite());
+    }
 
     #[test]
     fn lambert_reflects_albedo_over_pi() {
