@@ -88,23 +88,18 @@ pub fn variants(m: &Material) -> Vec<(&'static str, Material)> {
 /// relative standard error is below `precision` and enough rays were cast for glints to show, or
 /// `max_samples` rays are spent.
 ///
-/// Glints: a sharp specular lobe makes a ray's value heavy-tailed (bumpy-specular at 75°, light
-/// 30° on the viewer's side: a facet within the lobe is hit by about one ray in 10⁵–10⁶), and a
-/// batch that drew none has a small sample variance and a mean without the specular part, so the
-/// variance alone stopped after 50 000 rays with "0.34%" while the truth lacked 15–18% (4·10⁶
-/// rays: the model within 0.2%). `glint_bound` is the most one ray's specular term can carry
-/// (sun × [`BaseBrdf::specular_peak`]); an event of that size with probability q is missed by n
-/// rays with probability (1 − q)ⁿ, so after `n ≥ 3·bound/(precision·mean)` rays whatever is still
-/// unseen carries less than `precision` of the mean with 95% confidence ("rule of three").
+/// Glints ([`Evaluator::glint_rays`]): a sharp specular lobe makes a ray's value heavy-tailed, and
+/// a batch that drew none has a small sample variance and a mean without the specular part
+/// (bumpy-specular at 75°, light 30° on the viewer's side: "0.34%" after 50 000 rays, the truth
+/// 15–18% low; 4·10⁶ rays put the model within 0.2%).
 ///
-/// [`BaseBrdf::specular_peak`]: lodestone_core::microfacet::brdf::BaseBrdf::specular_peak
+/// [`Evaluator::glint_rays`]: lodestone_core::eval::Evaluator::glint_rays
 fn truth(
     p: &lodestone_core::eval::Evaluator,
     cfg: &FootprintQuery,
     precision: f64,
     max_samples: usize,
 ) -> Estimate {
-    let glint_bound = p.material.lighting.sun * p.material.brdf.specular_peak(cfg.wo, cfg.wi);
     let batch = 50_000.min(max_samples).max(2);
     let (mut n, mut sum, mut sum2) = (0usize, [0.0f64; 3], [0.0f64; 3]);
     let mut seed = 1;
@@ -130,7 +125,7 @@ fn truth(
             .map(|k| mean[k])
             .filter(|m| *m > 0.0)
             .fold(f64::INFINITY, f64::min);
-        let glints_seen = glint_bound <= 0.0 || nf * precision * smallest >= 3.0 * glint_bound;
+        let glints_seen = nf >= p.glint_rays(cfg, smallest, precision);
         if (rel <= precision && glints_seen) || n + batch > max_samples {
             return Estimate {
                 mean,

@@ -31,6 +31,10 @@ pub struct EvalReport {
     pub ground_truth_std_error: [f64; 3],
     /// Ground truth samples.
     pub samples: usize,
+    /// Rays before a glint as bright as the lobe's peak, carrying 1% of the mean, would have shown
+    /// with 95% confidence (`Evaluator::glint_rays`); fewer samples may have missed the specular
+    /// part, whatever the standard error says.
+    pub glint_rays: f64,
     /// Largest per-channel relative error against ground truth, per method.
     pub relative_error: RelativeErrors,
 }
@@ -83,6 +87,11 @@ pub fn eval(preset: &Resolved, angles: [f64; 4], samples: usize) -> Result<EvalR
         ground_truth: gt.mean,
         ground_truth_std_error: gt.std_error,
         samples: gt.samples,
+        glint_rays: prepared.glint_rays(
+            &cfg,
+            gt.mean.iter().copied().fold(f64::INFINITY, f64::min),
+            0.01,
+        ),
         relative_error: RelativeErrors {
             naive: rel(naive),
             view_independent: rel(vi),
@@ -94,7 +103,21 @@ pub fn eval(preset: &Resolved, angles: [f64; 4], samples: usize) -> Result<EvalR
 /// A human-readable table.
 pub fn table(r: &EvalReport) -> String {
     let c = |v: [f64; 3]| format!("{:>8.5} {:>8.5} {:>8.5}", v[0], v[1], v[2]);
-    format!(
+    let glints = if (r.samples as f64) < r.glint_rays {
+        format!(
+            "warning: the specular lobe's peak needs {} rays before a glint carrying 1% would have shown; \
+             with {} the truth may lack its glints (raise --spp)\n",
+            if r.glint_rays.is_finite() {
+                format!("{:.0}", r.glint_rays.ceil())
+            } else {
+                "unboundedly many".to_string()
+            },
+            r.samples
+        )
+    } else {
+        String::new()
+    };
+    let table = format!(
         "{} — view {}° (azimuth {}°), light {}° (azimuth {}°), {} ground-truth samples\n\
          method              R        G        B   max rel. error\n\
          naive MIP        {}   {:>6.2}%\n\
@@ -116,5 +139,6 @@ pub fn table(r: &EvalReport) -> String {
         100.0 * r.relative_error.filtered,
         c(r.ground_truth),
         c(r.ground_truth_std_error),
-    )
+    );
+    table + &glints
 }
