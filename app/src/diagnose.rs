@@ -121,11 +121,7 @@ fn truth(
             .filter(|&k| mean[k] > 0.0)
             .map(|k| std_error[k] / mean[k])
             .fold(0.0f64, f64::max);
-        let smallest = (0..3)
-            .map(|k| mean[k])
-            .filter(|m| *m > 0.0)
-            .fold(f64::INFINITY, f64::min);
-        let glints_seen = nf >= p.glint_rays(cfg, smallest, precision);
+        let glints_seen = nf >= p.glint_rays(cfg, mean, precision);
         if (rel <= precision && glints_seen) || n + batch > max_samples {
             return Estimate {
                 mean,

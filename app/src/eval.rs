@@ -87,11 +87,7 @@ pub fn eval(preset: &Resolved, angles: [f64; 4], samples: usize) -> Result<EvalR
         ground_truth: gt.mean,
         ground_truth_std_error: gt.std_error,
         samples: gt.samples,
-        glint_rays: prepared.glint_rays(
-            &cfg,
-            gt.mean.iter().copied().fold(f64::INFINITY, f64::min),
-            0.01,
-        ),
+        glint_rays: prepared.glint_rays(&cfg, gt.mean, 0.01),
         relative_error: RelativeErrors {
             naive: rel(naive),
             view_independent: rel(vi),

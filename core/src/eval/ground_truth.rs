@@ -24,25 +24,31 @@ pub const PATCH_GRID_CELLS: usize = 256;
 
 impl Evaluator {
     /// Rays the ground truth of `cfg` needs before a glint as bright as the base lobe's peak,
-    /// carrying `precision` of a mean of `mean`, would have been seen with 95% confidence: an
-    /// event of value B and probability q is missed by n rays with probability (1 − q)ⁿ ≤ e^(−nq),
-    /// so `n = 3·B/(precision·mean)` ("rule of three"), B = sun × [`BaseBrdf::specular_peak`]
-    /// (the base BRDF only: no statistical model). A sharp lobe makes a ray's value heavy-tailed,
-    /// and until then the sample variance cannot tell: bumpy-specular at 75°, light 30° on the
+    /// carrying `precision` of the mean, would have been seen with 95% confidence, for a truth
+    /// whose mean is about `mean` (linear RGB; its smallest positive channel counts): an event of
+    /// value B and probability q is missed by n rays with probability (1 − q)ⁿ ≤ e^(−nq), so
+    /// `n = 3·B/(precision·mean)` ("rule of three"), B = sun × [`BaseBrdf::specular_peak`] (the
+    /// base BRDF only: no statistical model). A sharp lobe makes a ray's value heavy-tailed, and
+    /// until then the sample variance cannot tell: bumpy-specular at 75°, light 30° on the
     /// viewer's side, reported 0.34% after 50 000 rays that had drawn no glint while the truth
-    /// lacked 15–18%. 0 without a specular lobe; infinite for a mean ≤ 0 or precision ≤ 0 with
-    /// a lobe.
+    /// lacked 15–18%. 0 without a specular lobe; infinite with one when no channel of `mean` is
+    /// positive or `precision` ≤ 0.
     ///
     /// [`BaseBrdf::specular_peak`]: crate::microfacet::brdf::BaseBrdf::specular_peak
-    pub fn glint_rays(&self, cfg: &FootprintQuery, mean: f64, precision: f64) -> f64 {
+    pub fn glint_rays(&self, cfg: &FootprintQuery, mean: [f64; 3], precision: f64) -> f64 {
         let bound = self.material.lighting.sun * self.material.brdf.specular_peak(cfg.wo, cfg.wi);
         if !(bound > 0.0) {
             return 0.0;
         }
-        if !(mean > 0.0 && precision > 0.0) {
+        let smallest = mean
+            .iter()
+            .copied()
+            .filter(|m| *m > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        if !(smallest.is_finite() && precision > 0.0) {
             return f64::INFINITY;
         }
-        3.0 * bound / (precision * mean)
+        3.0 * bound / (precision * smallest)
     }
 
     /// Ground truth by ray tracing the explicit surface with `samples` eye rays drawn from the

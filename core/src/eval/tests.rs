@@ -210,3 +210,31 @@ fn report_grazing_errors() {
         assert!(rel(fi) < 0.06, "filtered drifted at {deg}°");
     }
 }
+
+/// `glint_rays` on the cases that motivated it: bumpy-specular at 75°, light 30° on the viewer's
+/// side, needs millions of rays (50 000 had drawn no glint and reported 0.34%); the README's
+/// default example (75°, light at the normal, 40 000 rays) needs far fewer; no lobe, none.
+#[test]
+fn glint_rays_asks_for_millions_only_where_the_lobe_is_sharp() {
+    let (wo, wi) = (
+        direction(75f64.to_radians(), 0.0),
+        direction(30f64.to_radians(), 0.0),
+    );
+    let bumpy = Evaluator::new(&crate::eval::test_materials::preset("bumpy-specular")).unwrap();
+    let cfg = crate::eval::test_materials::far_patch(wo, wi);
+    let mean = bumpy.ground_truth(&cfg, 4000, 1).mean;
+    let n = bumpy.glint_rays(&cfg, mean, 0.01);
+    assert!(n > 1e6 && n.is_finite(), "{n}");
+    // A quarter of the precision asks for four times the rays.
+    assert!((bumpy.glint_rays(&cfg, mean, 0.0025) / n - 4.0).abs() < 1e-9);
+    let default = Evaluator::new(&crate::eval::test_materials::preset("default")).unwrap();
+    let readme = crate::eval::test_materials::far_patch(wo, DVec3::Z);
+    let m = default.ground_truth(&readme, 4000, 1).mean;
+    let d = default.glint_rays(&readme, m, 0.01);
+    assert!(d > 0.0 && d < 40_000.0, "{d}");
+    let mut matte = crate::eval::test_materials::preset("default");
+    matte.brdf.specular = 0.0;
+    let matte = Evaluator::new(&matte).unwrap();
+    assert_eq!(matte.glint_rays(&readme, m, 0.01), 0.0);
+    assert!(bumpy.glint_rays(&cfg, [0.0; 3], 0.01).is_infinite());
+}

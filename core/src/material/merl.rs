@@ -306,26 +306,32 @@ impl MerlBrdf {
         [0, 1, 2].map(|c| f64::from(self.values[c * ENTRIES + i]))
     }
 
-    /// Directional albedo toward ωo, `∫ ρ(ωi, ωo) cos θi dωi`, by a `n × 4n` midpoint rule in
-    /// (cos θi, φi): a summary for reports and tests.
+    /// Directional albedo toward ωo, `∫ ρ(ωi, ωo) cos θi dωi` ([`directional_albedo`]).
     pub fn albedo(&self, wo: DVec3, n: usize) -> [f64; 3] {
-        let n = n.max(1);
-        let mut sum = [0.0; 3];
-        let dw = 1.0 / n as f64 * (2.0 * PI / (4 * n) as f64);
-        for a in 0..n {
-            let mu = (a as f64 + 0.5) / n as f64;
-            let st = (1.0 - mu * mu).sqrt();
-            for b in 0..4 * n {
-                let phi = (b as f64 + 0.5) / (4 * n) as f64 * 2.0 * PI;
-                let wi = DVec3::new(st * phi.cos(), st * phi.sin(), mu);
-                let v = self.eval(wi, wo);
-                for c in 0..3 {
-                    sum[c] += v[c] * mu * dw;
-                }
+        directional_albedo(wo, n, |wi, wo| self.eval(wi, wo))
+    }
+}
+
+/// Directional albedo of a BRDF `rho(ωi, ωo)` (per steradian, linear RGB) toward ωo,
+/// `∫ ρ(ωi, ωo) cos θi dωi`, by an `n × 4n` midpoint rule in (cos θi, φi): a summary for reports
+/// and tests, for tables and analytic BRDFs alike.
+pub fn directional_albedo(wo: DVec3, n: usize, rho: impl Fn(DVec3, DVec3) -> [f64; 3]) -> [f64; 3] {
+    let n = n.max(1);
+    let mut sum = [0.0; 3];
+    let dw = 1.0 / n as f64 * (2.0 * PI / (4 * n) as f64);
+    for a in 0..n {
+        let mu = (a as f64 + 0.5) / n as f64;
+        let st = (1.0 - mu * mu).sqrt();
+        for b in 0..4 * n {
+            let phi = (b as f64 + 0.5) / (4 * n) as f64 * 2.0 * PI;
+            let wi = DVec3::new(st * phi.cos(), st * phi.sin(), mu);
+            let v = rho(wi, wo);
+            for c in 0..3 {
+                sum[c] += v[c] * mu * dw;
             }
         }
-        sum
     }
+    sum
 }
 
 #[cfg(test)]
@@ -441,19 +447,7 @@ mod tests {
         for theta_o in [0.0f64, 0.8, 1.2] {
             let wo = dir(theta_o, 0.3);
             let got = m.albedo(wo, 200);
-            let n = 200;
-            let mut want = [0.0; 3];
-            let dw = 1.0 / n as f64 * (2.0 * PI / (4 * n) as f64);
-            for a in 0..n {
-                let mu = (a as f64 + 0.5) / n as f64;
-                for b in 0..4 * n {
-                    let phi = (b as f64 + 0.5) / (4 * n) as f64 * 2.0 * PI;
-                    let v = analytic(dir(mu.acos(), phi), wo);
-                    for c in 0..3 {
-                        want[c] += v[c] * mu * dw;
-                    }
-                }
-            }
+            let want = directional_albedo(wo, 200, analytic);
             eprintln!("θo {theta_o}: table {got:.5?}, BRDF {want:.5?}");
             for c in 0..3 {
                 assert!(

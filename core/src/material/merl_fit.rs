@@ -193,6 +193,7 @@ impl MerlFit {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::material::merl::directional_albedo;
 
     #[test]
     fn a_table_of_the_base_model_gives_its_parameters_back() {
@@ -239,16 +240,7 @@ mod tests {
         );
         for theta_o in [0.0f64, 1.0] {
             let wo = DVec3::new(theta_o.sin(), 0.0, theta_o.cos());
-            let (n, mut fitted) = (100, 0.0);
-            for a in 0..n {
-                let mu = (a as f64 + 0.5) / n as f64;
-                for b in 0..4 * n {
-                    let phi = (b as f64 + 0.5) / (4 * n) as f64 * TAU;
-                    let st = (1.0 - mu * mu).sqrt();
-                    let wi = DVec3::new(st * phi.cos(), st * phi.sin(), mu);
-                    fitted += fit.eval(wi, wo)[0] * mu / n as f64 * TAU / (4 * n) as f64;
-                }
-            }
+            let fitted = directional_albedo(wo, 100, |wi, wo| fit.eval(wi, wo))[0];
             let measured = table.albedo(wo, 100)[0];
             eprintln!("θo {theta_o}: fitted albedo {fitted}, table {measured}");
             assert!(
