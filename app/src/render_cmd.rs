@@ -123,6 +123,22 @@ pub fn renderer() -> Result<Renderer> {
     Ok(Renderer::new(ctx))
 }
 
+/// "beyond truth noise: RMSE …" of block errors against the truth, or why it is unknown.
+fn noise_line(b: Option<&BlockErrors>) -> String {
+    match b {
+        Some(b) => {
+            let (lo, hi) = b.rmse_range(2.0);
+            format!(
+                "beyond truth noise on {k}×{k} blocks: RMSE {:.5} ({lo:.5}–{hi:.5}), {:.0}% of blocks significant",
+                b.rmse(),
+                b.significant_fraction() * 100.0,
+                k = b.block
+            )
+        }
+        None => "truth noise unknown (fewer than 2 rays per pixel)".to_string(),
+    }
+}
+
 /// `lodestone render`.
 pub fn render(
     preset: &Resolved,
@@ -146,22 +162,9 @@ pub fn render(
         r.draw(&mut t, &gm, &scene, ViewMode::Truth, spp);
         Ok((t.read(&r)?, t.read_moments(&r)?))
     };
-    // "beyond truth noise: RMSE …" for `img` against the truth, or why it is unknown.
-    let beyond_noise = |img: &LinearImage, truth: &LinearImage, moments: &SampleMoments| {
-        match TruthEstimate::new(truth, moments)
-            .and_then(|t| BlockErrors::new(img, &t, view.error_block))
-        {
-            Some(b) => {
-                let (lo, hi) = b.rmse_range(2.0);
-                format!(
-                    "beyond truth noise on {k}×{k} blocks: RMSE {:.5} ({lo:.5}–{hi:.5}), {:.0}% of blocks significant",
-                    b.rmse(),
-                    b.significant_fraction() * 100.0,
-                    k = view.error_block
-                )
-            }
-            None => "truth noise unknown (fewer than 2 rays per pixel)".to_string(),
-        }
+    // The block errors of `img` against the truth (None while its noise is unknown).
+    let blocks_of = |img: &LinearImage, truth: &LinearImage, moments: &SampleMoments| {
+        TruthEstimate::new(truth, moments).and_then(|t| BlockErrors::new(img, &t, view.error_block))
     };
     match mode {
         RenderMode::Naive => save(&draw(ViewMode::Naive)?, out)?,
@@ -176,7 +179,7 @@ pub fn render(
                 s.rmse,
                 s.max,
                 s.max,
-                beyond_noise(&f, &t, &tm)
+                noise_line(blocks_of(&f, &t, &tm).as_ref())
             );
             save(&heat_map(&f, &t, s.max), out)?;
         }
@@ -190,10 +193,9 @@ pub fn render(
             // The error maps compare block means against the truth with its noise taken out
             // (blocks within the noise grey), as the editor does; per pixel while the truth's
             // noise is unknown (one ray). One legend for every map: the largest error of any mode.
-            let estimate = TruthEstimate::new(&truth, &moments);
             let blocks: Vec<Option<BlockErrors>> = modes
                 .iter()
-                .map(|(_, i)| estimate.and_then(|t| BlockErrors::new(i, &t, view.error_block)))
+                .map(|(_, i)| blocks_of(i, &truth, &moments))
                 .collect();
             let scale = modes
                 .iter()
@@ -212,7 +214,7 @@ pub fn render(
                     "{name:>16} vs truth: RMSE {:.5}, max {:.5}; {}",
                     s.rmse,
                     s.max,
-                    beyond_noise(img, &truth, &moments)
+                    noise_line(block.as_ref())
                 );
                 encoded_as(img, name, formats, &mut set)?;
                 let heat = match block {
