@@ -380,12 +380,16 @@ impl EditorApp {
                 self.toggle_baseline();
             }
         }
-        ui.painter().rect_filled(img, 0.0, Color32::from_gray(20));
         let tex = if show_error {
             self.errors.get(&rm).map(|e| e.texture.id())
         } else {
             self.shown.get(&rm).map(|s| s.texture.id())
         };
+        // The image covers the whole rect: a backdrop under it would only cost fill (on a
+        // software adapter the window's frame rate is bound by fill).
+        if tex.is_none() {
+            ui.painter().rect_filled(img, 0.0, Color32::from_gray(20));
+        }
         // All views render at the widest view's size; narrower ones show the centre.
         let u = (img.width() / max_w).clamp(0.0, 1.0);
         let uv = Rect::from_min_max(Pos2::new(0.5 - u * 0.5, 0.0), Pos2::new(0.5 + u * 0.5, 1.0));
