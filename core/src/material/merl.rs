@@ -479,9 +479,13 @@ mod tests {
             MerlBrdf::from_bytes(&dims),
             Err(MerlError::Dimensions(90, 90, 360))
         ));
+        // Entry i of channel c set to v, in a copy of the file.
+        let put = |bytes: &mut [u8], c: usize, i: usize, v: f64| {
+            let at = 12 + 8 * (c * ENTRIES + i);
+            bytes[at..at + 8].copy_from_slice(&v.to_le_bytes());
+        };
         let mut nan = good.clone();
-        let at = 12 + 8 * (ENTRIES + 77);
-        nan[at..at + 8].copy_from_slice(&f64::NAN.to_le_bytes());
+        put(&mut nan, 1, 77, f64::NAN);
         let e = MerlBrdf::from_bytes(&nan).unwrap_err();
         assert!(
             matches!(
@@ -497,15 +501,13 @@ mod tests {
         // A few unmeasured bins are read as 0; a channel mostly negative is refused.
         let mut few = good.clone();
         for i in [5usize, 500, 5000] {
-            let at = 12 + 8 * i;
-            few[at..at + 8].copy_from_slice(&(-1.0f64).to_le_bytes());
+            put(&mut few, 0, i, -1.0);
         }
         let m = MerlBrdf::from_bytes(&few).expect("a few unmeasured bins");
         assert_eq!(m.unmeasured(), [3, 0, 0]);
         let mut neg = good.clone();
         for i in 0..ENTRIES / 10 {
-            let at = 12 + 8 * (2 * ENTRIES + i);
-            neg[at..at + 8].copy_from_slice(&(-0.5f64).to_le_bytes());
+            put(&mut neg, 2, i, -0.5);
         }
         let e = MerlBrdf::from_bytes(&neg).unwrap_err();
         assert!(
