@@ -276,6 +276,7 @@ mod tests {
                 albedo: 1.0,
                 specular: 0.3,
                 roughness: 0.1,
+                measured: None,
             },
             ..lodestone_core::material::Material::default()
         };

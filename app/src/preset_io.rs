@@ -7,6 +7,8 @@ use lodestone_core::driver::DriverError;
 use lodestone_core::driver::image::ImageDriver;
 use lodestone_core::eval::Evaluator;
 use lodestone_core::material::environment::{Environment, EnvironmentSource, EquirectMap};
+use lodestone_core::material::measured::MeasuredBrdf;
+use lodestone_core::material::merl::MerlBrdf;
 use lodestone_core::material::{Driver, Material, MaterialError};
 use lodestone_core::math::sh::Sh9;
 use std::io::Write;
@@ -56,6 +58,16 @@ pub enum PresetError {
         /// What is wrong (missing, not an image, too large, not finite).
         reason: String,
     },
+    /// The base BRDF's measured file cannot be used.
+    #[error("{preset}: measured BRDF {file}: {reason}")]
+    Measured {
+        /// The preset.
+        preset: PathBuf,
+        /// The MERL file, resolved against the preset's folder.
+        file: PathBuf,
+        /// What is wrong (missing, wrong size, not finite, too many negative entries).
+        reason: String,
+    },
     /// The file cannot be written.
     #[error("cannot save {path}: {error}")]
     Write {
@@ -86,6 +98,8 @@ pub struct Resolved {
     /// The SH9 radiance of the lighting's environment file (before its intensity); `None` without
     /// a file (the procedural sky needs none).
     pub environment: Option<Sh9>,
+    /// The base BRDF's measured table and its fit; `None` for the analytic BRDF.
+    pub measured: Option<Arc<MeasuredBrdf>>,
 }
 
 impl Resolved {
@@ -95,6 +109,7 @@ impl Resolved {
             material,
             image: None,
             environment: None,
+            measured: None,
         }
     }
 
@@ -103,6 +118,9 @@ impl Resolved {
         let mut p = Evaluator::with_image(&self.material, self.image.clone(), None)?;
         if let Some(sh) = &self.environment {
             p.set_environment_radiance(sh);
+        }
+        if let Some(m) = &self.measured {
+            p.set_measured(m.clone());
         }
         Ok(p)
     }
@@ -171,10 +189,12 @@ pub fn load_resolved(path: &Path) -> Result<Resolved, PresetError> {
     })?;
     let image = driver_image(&material, Some(path))?;
     let environment = environment_file(&material, Some(path))?;
+    let measured = measured_file(&material, Some(path))?;
     Ok(Resolved {
         material,
         image,
         environment,
+        measured,
     })
 }
 
@@ -194,6 +214,36 @@ pub fn environment_file(
     let dir = preset.and_then(|p| p.parent()).unwrap_or(Path::new("."));
     let full = dir.join(path);
     load_environment(preset.unwrap_or(Path::new("(unsaved material)")), &full).map(Some)
+}
+
+/// The measured base BRDF `material` names (a MERL file, its path relative to the folder of
+/// `preset`), read, checked and fitted; `None` for the analytic BRDF.
+pub fn measured_file(
+    material: &Material,
+    preset: Option<&Path>,
+) -> Result<Option<Arc<MeasuredBrdf>>, PresetError> {
+    let Some(path) = &material.brdf.measured else {
+        return Ok(None);
+    };
+    let dir = preset.and_then(|p| p.parent()).unwrap_or(Path::new("."));
+    load_measured(
+        preset.unwrap_or(Path::new("(unsaved material)")),
+        &dir.join(path),
+    )
+    .map(|m| Some(Arc::new(m)))
+}
+
+/// Read a MERL file (a regular file of exactly the format's size, every entry finite, at most
+/// [`lodestone_core::material::merl::MAX_UNMEASURED_SHARE`] negative) and fit it.
+pub fn load_measured(preset: &Path, file: &Path) -> Result<MeasuredBrdf, PresetError> {
+    let err = |reason: String| PresetError::Measured {
+        preset: preset.to_owned(),
+        file: file.to_owned(),
+        reason,
+    };
+    check_regular_file(file, MAX_IMAGE_FILE_BYTES).map_err(|e| err(e.to_string()))?;
+    let table = MerlBrdf::read(file).map_err(|e| err(e.to_string()))?;
+    Ok(MeasuredBrdf::new(table))
 }
 
 /// Largest side of an environment file (projection reads every texel once).
@@ -349,7 +399,7 @@ fn sync_dir(dir: &Path) -> std::io::Result<()> {
 
 /// Write the engine bundle of `m` into `dir` (created if needed); returns the files written.
 ///
-/// The files a preset names (a driver image, an environment file), resolved against the folder of
+/// The files a preset names (a driver image, an environment file, a measured BRDF), resolved against the folder of
 /// `preset` (the current folder without one), are copied beside it and the bundle's `material.ron`
 /// names the copies, so the bundle reopens anywhere. Every file is first written to a temporary
 /// name in `dir` and flushed; only then are they renamed into place, `manifest.json` last, so an
@@ -443,6 +493,11 @@ fn bundled_material(
                     image: from.clone(),
                     reason,
                 },
+                "brdf-" => PresetError::Measured {
+                    preset,
+                    file: from.clone(),
+                    reason,
+                },
                 _ => PresetError::Environment {
                     preset,
                     file: from.clone(),
@@ -465,6 +520,9 @@ fn bundled_material(
     }) = &mut out.lighting.environment
     {
         bundle(path, "environment-")?;
+    }
+    if let Some(path) = &mut out.brdf.measured {
+        bundle(path, "brdf-")?;
     }
     Ok((out, copies))
 }
@@ -500,6 +558,9 @@ pub fn relocate(m: &Material, from: Option<&Path>, to: &Path) -> Material {
         ..
     }) = &mut out.lighting.environment
     {
+        fix(path);
+    }
+    if let Some(path) = &mut out.brdf.measured {
         fix(path);
     }
     out

@@ -524,6 +524,108 @@ fn environment_file_matches_the_procedural_sky_and_a_missing_one_exits_2() {
     );
 }
 
+/// A measured BRDF beside the preset (#18 §2): a MERL file of a Lambertian BRDF of albedo 0.8
+/// evaluates like the analytic Lambertian of albedo 0.8 in every method; bad files (missing,
+/// truncated, NaN, mostly negative) exit 2 with a message that names the file and the fault, and
+/// `export` bundles the file.
+#[test]
+fn a_measured_brdf_beside_the_preset_evaluates_and_bad_ones_exit_2() {
+    use lodestone_core::material::merl::MerlBrdf;
+    let dir = std::env::temp_dir().join(format!("lodestone-cli-merl-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let lambert = MerlBrdf::tabulate(|_, _| [0.8 / std::f64::consts::PI; 3]).to_bytes();
+    std::fs::write(dir.join("lambert.binary"), &lambert).unwrap();
+    let base = include_str!("../../presets/default.ron");
+    let analytic_brdf = "albedo: 0.8,\n        specular: 0.0,\n        roughness: 0.15,";
+    let old = "albedo: 1.0,\n        specular: 0.04,\n        roughness: 0.15,";
+    assert!(
+        base.contains(old),
+        "default.ron's BRDF changed: update this test"
+    );
+    let analytic = dir.join("analytic.ron");
+    std::fs::write(&analytic, base.replace(old, analytic_brdf)).unwrap();
+    let with = |name: &str, file: &str| {
+        let p = dir.join(name);
+        let brdf = format!("{analytic_brdf}\n        measured: Some(\"{file}\"),");
+        std::fs::write(&p, base.replace(old, &brdf)).unwrap();
+        p
+    };
+    let measured = with("measured.ron", "lambert.binary");
+    let eval = |p: &std::path::Path| {
+        let out = lodestone(&[
+            "--preset",
+            p.to_str().unwrap(),
+            "eval",
+            "--view-deg",
+            "60",
+            "--light-deg",
+            "30",
+            "--spp",
+            "300",
+            "--json",
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()
+    };
+    let (a, b) = (eval(&analytic), eval(&measured));
+    for key in ["naive", "view_independent", "filtered", "ground_truth"] {
+        for k in 0..3 {
+            let (x, y) = (a[key][k].as_f64().unwrap(), b[key][k].as_f64().unwrap());
+            assert!(
+                (x - y).abs() <= 1e-5 * x.abs(),
+                "{key}: analytic {x}, measured {y}"
+            );
+        }
+    }
+    let out = lodestone(&[
+        "--preset",
+        measured.to_str().unwrap(),
+        "export",
+        "--out",
+        dir.join("bundle").to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read(dir.join("bundle").join("brdf-lambert.binary")).unwrap(),
+        lambert
+    );
+    // Bad files: each exits 2, naming the file and what is wrong with it.
+    let mut nan = lambert.clone();
+    nan[12 + 8 * 1000..12 + 8 * 1001].copy_from_slice(&f64::NAN.to_le_bytes());
+    let mut negative = lambert.clone();
+    for i in 0..lambert.len().saturating_sub(12) / 8 {
+        negative[12 + 8 * i..20 + 8 * i].copy_from_slice(&(-1.0f64).to_le_bytes());
+    }
+    for (file, bytes, says) in [
+        (
+            "truncated.binary",
+            Some(&lambert[..lambert.len() / 2]),
+            "truncated",
+        ),
+        ("nan.binary", Some(&nan[..]), "NaN"),
+        ("negative.binary", Some(&negative[..]), "negative"),
+        ("missing.binary", None, "No such file"),
+    ] {
+        if let Some(b) = bytes {
+            std::fs::write(dir.join(file), b).unwrap();
+        }
+        let p = with(&format!("{file}.ron"), file);
+        let out = lodestone(&["--preset", p.to_str().unwrap(), "eval", "--spp", "10"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{file}: {err}");
+        assert!(err.contains(file) && err.contains(says), "{file}: {err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `lodestone bench` sweeps presets × distances × view angles: one row each, every mode and the
 /// flat reference timed (finite, positive), the ratios consistent with the times; a missing preset
 /// in the sweep exits 2 naming it.

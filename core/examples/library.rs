@@ -53,6 +53,7 @@ fn preset(name: &str) -> Option<(&'static str, Material)> {
                     albedo: 1.0,
                     specular: 0.02,
                     roughness: 0.3,
+                    measured: None,
                 },
                 ..base
             },
@@ -102,6 +103,7 @@ fn preset(name: &str) -> Option<(&'static str, Material)> {
                     albedo: 1.0,
                     specular: 0.6,
                     roughness: 0.04,
+                    measured: None,
                 },
                 ..base
             },
@@ -155,6 +157,7 @@ fn preset(name: &str) -> Option<(&'static str, Material)> {
                     albedo: 1.0,
                     specular: 0.0,
                     roughness: 0.2,
+                    measured: None,
                 },
                 ..base
             },
@@ -210,6 +213,7 @@ fn preset(name: &str) -> Option<(&'static str, Material)> {
                     albedo: 1.0,
                     specular: 0.04,
                     roughness: 0.25,
+                    measured: None,
                 },
                 ..base
             },

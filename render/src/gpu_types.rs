@@ -287,6 +287,15 @@ gpu_struct! {
         is_offset: u32 => "u32",
         /// 1 when the mixture's bins carry the image's value-conditioned slopes, 0 otherwise.
         is_on: u32 => "u32",
+        /// 1 when a measured base BRDF's table is in the data buffer (core's
+        /// `material::measured`): facets are looked up in it, the specular lobe takes their colour.
+        measured: u32 => "u32",
+        /// Diffuse albedo weight per channel (core's `ChannelWeights::kd`; 1 for the analytic BRDF).
+        kd_rgb: [f32; 3] => "vec3<f32>",
+        /// Offset of the measured table: red, green, blue channels of `MERL_ENTRIES` each.
+        merl_offset: u32 => "u32",
+        /// Specular weight per channel (core's `ChannelWeights::f0`; 1 for the analytic BRDF).
+        f0_rgb: [f32; 3] => "vec3<f32>",
         /// Padding to WGSL's 16-byte struct size.
         pad3: u32 => "u32",
     }

@@ -660,6 +660,15 @@ pub fn material_data_for(
         }
         mark(&data, start, "environment SH9");
     }
+    if let Some(measured) = &prepared.measured
+        && features.contains(Feature::Measured)
+    {
+        let start = data.len();
+        base.merl_offset = data.len() as u32;
+        base.measured = 1;
+        data.extend(measured.table.values());
+        mark(&data, start, "measured BRDF table");
+    }
     if let TransferFunction::Curve(c) = &m.heights.transfer {
         let p = c.moment_poly();
         let start = data.len();
@@ -681,6 +690,9 @@ pub fn material_data_for(
     base.cp_offset = lay.color_poly;
     base.tp_offset = lay.transfer_poly;
     base.sigma_h = s.sigma_h as f32;
+    let weights = prepared.channel_weights();
+    base.kd_rgb = weights.kd.map(|v| v as f32);
+    base.f0_rgb = weights.f0.map(|v| v as f32);
     base.albedo = m.brdf.albedo as f32;
     base.specular = m.brdf.specular as f32;
     base.roughness = m.brdf.roughness as f32;

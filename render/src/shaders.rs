@@ -42,6 +42,8 @@ pub const MATERIAL_FILES: &[(&str, &str)] = wgsl_files![
     "material/table_slope.wgsl",
     "material/transfer.wgsl",
     "material/color_terms.wgsl",
+    "material/merl.wgsl",
+    "material/measured.wgsl",
     "driver/footprint.wgsl",
     "driver/noise.wgsl",
     "driver/field.wgsl",

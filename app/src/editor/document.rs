@@ -1,5 +1,6 @@
 //! The document being edited: the material, its undo history, the file it came from and what was
-//! last saved there, and the files it references (driver image, environment map), each loaded once
+//! last saved there, and the files it references (driver image, environment map, measured BRDF),
+//! each loaded once
 //! per resolved path on a thread of its own (a 1 GiB image or an 8192² environment decodes for
 //! seconds; the window keeps painting meanwhile).
 
@@ -7,6 +8,7 @@ use super::history::History;
 use crate::preset_io;
 use lodestone_core::driver::image::ImageDriver;
 use lodestone_core::material::environment::{Environment, EnvironmentSource};
+use lodestone_core::material::measured::MeasuredBrdf;
 use lodestone_core::material::{Driver, Material};
 use lodestone_core::math::sh::Sh9;
 use std::path::{Path, PathBuf};
@@ -29,6 +31,8 @@ pub struct Document {
     image: Option<Slot<Arc<ImageDriver>>>,
     /// The lighting's environment file: resolved path and its SH9 radiance (cached likewise).
     environment: Option<Slot<Sh9>>,
+    /// The base BRDF's measured file: resolved path, its table and fit (cached likewise).
+    measured: Option<Slot<Arc<MeasuredBrdf>>>,
 }
 
 /// A referenced file: being loaded on its own thread, or loaded (or failed).
@@ -62,6 +66,8 @@ pub struct LoadedFiles {
     pub image: Option<Arc<ImageDriver>>,
     /// The environment file's SH9 radiance.
     pub environment: Option<Sh9>,
+    /// The measured base BRDF.
+    pub measured: Option<Arc<MeasuredBrdf>>,
     /// Failures loaded just now.
     pub new_errors: Vec<String>,
     /// Files still loading (resolved paths): the material cannot be rendered yet.
@@ -116,6 +122,7 @@ impl Document {
             path,
             image: None,
             environment: None,
+            measured: None,
         }
     }
 
@@ -167,6 +174,14 @@ impl Document {
         }
     }
 
+    /// The loaded measured BRDF, when the material names one and its file loaded.
+    pub fn measured(&self) -> Option<Arc<MeasuredBrdf>> {
+        match (&self.material.brdf.measured, &self.measured) {
+            (Some(_), Some(Slot::Done(_, Ok(m)))) => Some(m.clone()),
+            _ => None,
+        }
+    }
+
     /// The driver image and environment radiance, from the cache unless a path changed (cheap
     /// enough for every frame: nothing is cloned but the `Arc`).
     pub fn load_files(&mut self) -> LoadedFiles {
@@ -205,9 +220,22 @@ impl Document {
             }
             _ => None,
         };
+        let (m, p) = (material.clone(), preset.map(Path::to_owned));
+        let measured = material.brdf.measured.as_ref().map(|path| {
+            let full = dir.join(path);
+            (
+                full.clone(),
+                cached_load(&mut self.measured, full, move || {
+                    preset_io::measured_file(&m, p.as_deref())
+                        .map_err(|e| e.to_string())
+                        .and_then(|i| i.ok_or_else(|| "no measured BRDF".to_owned()))
+                }),
+            )
+        });
         let mut loaded = LoadedFiles::default();
         loaded.image = image.and_then(|r| loaded.take(r));
         loaded.environment = environment.and_then(|r| loaded.take(r));
+        loaded.measured = measured.and_then(|r| loaded.take(r));
         loaded
     }
 }

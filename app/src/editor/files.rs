@@ -192,7 +192,7 @@ impl EditorApp {
     }
 
     /// Files dropped on the window: a `.ron` opens (asking first), an `.hdr`/`.exr` becomes the
-    /// environment (an undoable edit).
+    /// environment and a `.binary` (MERL) the measured base BRDF (undoable edits).
     pub(super) fn handle_drops(&mut self, ctx: &egui::Context) {
         let dropped: Vec<PathBuf> = ctx.input(|i| {
             i.raw
@@ -206,7 +206,17 @@ impl EditorApp {
             let ext = p
                 .extension()
                 .map(|e| e.to_string_lossy().to_ascii_lowercase());
-            if matches!(ext.as_deref(), Some("exr" | "hdr")) {
+            if ext.as_deref() == Some("binary") {
+                // A MERL measured BRDF: the base BRDF becomes that file (an undoable edit).
+                let dir = self.doc.path.as_ref().and_then(|p| p.parent());
+                let path = dir
+                    .and_then(|d| p.strip_prefix(d).ok())
+                    .unwrap_or(&p)
+                    .display()
+                    .to_string();
+                self.doc.material.brdf.measured = Some(path.clone());
+                self.notify(ctx, format!("Measured BRDF: {path}"), false);
+            } else if matches!(ext.as_deref(), Some("exr" | "hdr")) {
                 // An environment map: the lighting's environment becomes that file (an undoable
                 // edit); relative to the preset's folder when it lies inside it.
                 let dir = self.doc.path.as_ref().and_then(|p| p.parent());

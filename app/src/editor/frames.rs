@@ -142,6 +142,7 @@ impl EditorApp {
             material: Arc::new(self.doc.material.clone()),
             image: resolved.image,
             environment: resolved.environment,
+            measured: resolved.measured,
             scene,
             size: self.view_px,
             modes,

@@ -11,9 +11,11 @@ use lodestone_core::material::color_terms::{CombineMode, ConstantTerm, SlopeTerm
 use lodestone_core::material::colormap::Gradient;
 use lodestone_core::material::environment::{Environment, EnvironmentSource, Lighting, Sky};
 use lodestone_core::material::features::{Feature, FeatureSet};
+use lodestone_core::material::merl_fit::MerlFit;
 use lodestone_core::material::slope_color::SlopeColor;
 use lodestone_core::material::transfer::{SurfaceShape, TransferFunction};
 use lodestone_core::material::{ColorModel, ColorSource, Driver, Filtering, Material};
+use lodestone_core::microfacet::brdf::BaseBrdf;
 use lodestone_core::microfacet::effective_height::HeightFilter;
 use lodestone_core::microfacet::height_mixture::TransferSlopes;
 use lodestone_core::microfacet::masking_shadowing::Correlation;
@@ -33,6 +35,8 @@ pub struct Inspector {
     pub isotropic_lock: bool,
     /// Skewness and excess kurtosis of the loaded image driver, if any (set by the editor).
     pub driver_shape: Option<(f64, f64)>,
+    /// The measured BRDF's fit (set by the editor when the material's file has loaded).
+    pub measured_fit: Option<MerlFit>,
     /// The loaded image driver, if any (set by the editor): the height histogram shows its texels.
     pub driver_image: Option<Arc<ImageDriver>>,
     /// The transfer curve's non-Gaussianity, cached with the curve it was computed for.
@@ -216,14 +220,17 @@ impl Inspector {
         egui::CollapsingHeader::new("Base BRDF")
             .default_open(true)
             .show(ui, |ui| {
+                changed |= self.measured_brdf(ui, &mut m.brdf);
                 let b = &mut m.brdf;
+                ui.add_enabled_ui(b.measured.is_none(), |ui| {
                 changed |= slider_f64(ui, &mut b.albedo, 0.0..=1.0, "Albedo",
-                    "Lambertian albedo multiplying the colour map, ρ_d·C/π", false);
+                    "Lambertian albedo multiplying the colour map, ρ_d·C/π (unused with a measured BRDF)", false);
                 changed |= slider_f64(ui, &mut b.specular, 0.0..=1.0, "Specular",
-                    "Specular reflectance of the slope-space Beckmann lobe", false);
+                    "Specular reflectance of the slope-space Beckmann lobe (unused with a measured BRDF)", false);
                 ui.add_enabled_ui(b.specular > 0.0, |ui| {
                 changed |= slider_f64(ui, &mut b.roughness, 0.001..=1.0, "Roughness σ_n0",
                     "σ_n0: base roughness (slope std of the BRDF lobe); filtered adds the footprint's slope variance, σ_n0² + σ_n² [HN12 Sec. 5.5]. Unused while Specular is 0", true);
+                });
                 });
             });
         egui::CollapsingHeader::new("Filtering")
@@ -232,6 +239,72 @@ impl Inspector {
                 changed |= filtering(ui, &mut m.filtering);
                 transfer_model_note(ui, m);
             });
+        changed
+    }
+
+    /// The base BRDF's kind (analytic or a measured MERL file), the file, and the fit the
+    /// filtered views use with its error.
+    fn measured_brdf(&mut self, ui: &mut Ui, b: &mut BaseBrdf) -> bool {
+        let mut changed = false;
+        let measured = b.measured.is_some();
+        let mut want = measured;
+        egui::ComboBox::from_label("BRDF kind")
+            .selected_text(if measured { "Measured (MERL)" } else { "Analytic" })
+            .show_ui(ui, |ui| {
+                ui.selectable_value(&mut want, false, "Analytic");
+                ui.selectable_value(&mut want, true, "Measured (MERL)");
+            })
+            .response
+            .on_hover_text(
+                "Analytic: Lambert plus a slope-space Beckmann lobe. Measured: a MERL isotropic \
+                 BRDF table (.binary, 90×90×180 half/difference angles) that ground truth and naive \
+                 look up per facet; the filtered views use its Lambert-plus-Beckmann fit. The colour \
+                 map tints the whole measured BRDF (white shows it as measured). Drop a .binary file \
+                 on the window to use it",
+            );
+        if want != measured {
+            b.measured = want.then(String::new);
+            changed = true;
+        }
+        if let Some(path) = &mut b.measured {
+            ui.horizontal(|ui| {
+                let l = ui.label("Measured file");
+                changed |= ui
+                    .text_edit_singleline(path)
+                    .labelled_by(l.id)
+                    .on_hover_text("MERL .binary file, relative to the preset's folder")
+                    .lost_focus();
+                if ui.button("Browse…").clicked()
+                    && let Some(p) = rfd::FileDialog::new()
+                        .add_filter("MERL BRDF", &["binary"])
+                        .pick_file()
+                {
+                    *path = p.display().to_string();
+                    changed = true;
+                }
+            });
+            match &self.measured_fit {
+                Some(f) => {
+                    ui.label(format!(
+                        "Fit for the filtered views: kd ({:.3}, {:.3}, {:.3}), F0 ({:.3}, {:.3}, {:.3}), σ {:.3}",
+                        f.kd[0], f.kd[1], f.kd[2], f.f0[0], f.f0[1], f.f0[2], f.sigma
+                    ));
+                    let worst = f.relative_error.iter().copied().fold(0.0, f64::max);
+                    let text = format!(
+                        "Fit error: {:.1}% RMS of ρ·cos (worst channel)",
+                        100.0 * worst
+                    );
+                    if worst > 0.1 {
+                        ui.colored_label(ui.visuals().warn_fg_color, text);
+                    } else {
+                        ui.label(text);
+                    }
+                }
+                None => {
+                    ui.weak("Not loaded (see the status bar)");
+                }
+            }
+        }
         changed
     }
 

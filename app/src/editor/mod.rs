@@ -293,7 +293,7 @@ impl EditorApp {
         self.recent.truncate(MAX_RECENT);
     }
 
-    /// The material with its driver image and environment file, loaded relative to the preset's
+    /// The material with its driver image, environment file and measured BRDF, loaded relative to the preset's
     /// folder (the current directory for an unsaved material). A load failure is reported once per
     /// path and leaves the file out (the views then show the material error, or no environment).
     /// `None` while a file is still loading (the status bar says which; the window repaints until
@@ -308,6 +308,7 @@ impl EditorApp {
             material: self.doc.material.clone(),
             image: files.image,
             environment: files.environment,
+            measured: files.measured,
         })
     }
 
@@ -425,10 +426,14 @@ impl eframe::App for EditorApp {
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().show(ui, |ui| {
                     ui.heading("Material");
-                    if matches!(self.doc.material.driver, Driver::Image { .. }) {
-                        // Loads the image when its path changed (cached otherwise).
+                    if matches!(self.doc.material.driver, Driver::Image { .. })
+                        || self.doc.material.brdf.measured.is_some()
+                    {
+                        // Loads the image or the measured BRDF when its path changed (cached
+                        // otherwise).
                         let _ = self.load_files(&ctx);
                     }
+                    self.inspector.measured_fit = self.doc.measured().map(|m| m.fit);
                     self.inspector.driver_image = self.doc.driver_image();
                     self.inspector.driver_shape = self
                         .inspector

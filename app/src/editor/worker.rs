@@ -15,6 +15,7 @@
 use lodestone_core::driver::image::ImageDriver;
 use lodestone_core::eval::Evaluator;
 use lodestone_core::material::Material;
+use lodestone_core::material::measured::MeasuredBrdf;
 use lodestone_core::math::sh::Sh9;
 use lodestone_render::truth_noise::SampleMoments;
 use lodestone_render::{
@@ -35,6 +36,8 @@ pub struct Request {
     pub image: Option<Arc<ImageDriver>>,
     /// The SH9 radiance of its environment file (file environments only).
     pub environment: Option<Sh9>,
+    /// Its measured base BRDF (materials that name one, once the file has loaded).
+    pub measured: Option<Arc<MeasuredBrdf>>,
     /// Camera and light.
     pub scene: Scene,
     /// Full size of one view in physical pixels.
@@ -195,6 +198,8 @@ struct State {
     prepared: Option<Evaluator>,
     /// The environment radiance the prepared material was given.
     environment: Option<Sh9>,
+    /// The measured BRDF the prepared material was given.
+    measured: Option<Arc<MeasuredBrdf>>,
     /// Seconds per pixel of each analytic mode, measured.
     cost: Vec<(ViewMode, f64)>,
     truth: Option<ViewTarget>,
@@ -207,6 +212,7 @@ impl State {
             material: None,
             prepared: None,
             environment: None,
+            measured: None,
             cost: Vec::new(),
             truth: None,
         }
@@ -252,6 +258,7 @@ impl State {
         material: &Arc<Material>,
         image: &Option<Arc<ImageDriver>>,
         environment: &Option<Sh9>,
+        measured: &Option<Arc<MeasuredBrdf>>,
         send: &dyn Fn(Event),
     ) -> bool {
         let same_image = |p: &Evaluator| match (p.surface.driver.image(), image) {
@@ -263,6 +270,11 @@ impl State {
             && (Arc::ptr_eq(m, material) || **m == **material)
             && self.prepared.as_ref().is_some_and(same_image)
             && self.environment == *environment
+            && match (&self.measured, measured) {
+                (None, None) => true,
+                (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+                _ => false,
+            }
         {
             return true;
         }
@@ -273,6 +285,10 @@ impl State {
                     p.set_environment_radiance(sh);
                 }
                 self.environment = *environment;
+                if let Some(m) = measured {
+                    p.set_measured(m.clone());
+                }
+                self.measured = measured.clone();
                 match GpuMaterial::new(self.renderer.context(), &p, [0.0, 0.0]) {
                     Ok(gm) => {
                         self.material = Some((material.clone(), gm));
@@ -335,7 +351,13 @@ impl State {
         rx: &Receiver<Request>,
         send: &dyn Fn(Event),
     ) -> Result<Option<Request>, ()> {
-        if !self.upload(&req.material, &req.image, &req.environment, send) {
+        if !self.upload(
+            &req.material,
+            &req.image,
+            &req.environment,
+            &req.measured,
+            send,
+        ) {
             return Ok(None);
         }
         if let Some((_, gm)) = &self.material {
@@ -481,6 +503,7 @@ mod tests {
             material: Arc::new(Material::default()),
             image: None,
             environment: None,
+            measured: None,
             scene: Scene {
                 camera: Camera::default(),
                 light: direction(0.5, 1.0),

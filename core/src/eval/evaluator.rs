@@ -10,6 +10,7 @@ use crate::driver::image::ImageDriver;
 use crate::eval::compiled::{CompiledColor, CompiledTransfer};
 use crate::material::Material;
 use crate::material::environment::EquirectMap;
+use crate::material::measured::{ChannelWeights, MeasuredBrdf};
 use crate::material::slope_color::CompiledSlopeColor;
 use crate::math::sh::Sh9;
 use crate::scene::surface::Surface;
@@ -37,6 +38,10 @@ pub struct Evaluator {
     /// set by the application for a file ([`Evaluator::set_environment_map`]); `None` = no
     /// environment light (or a file not loaded yet).
     pub environment: Option<Sh9>,
+    /// The measured base BRDF named by `material.brdf.measured`, set by the application once the
+    /// file is read ([`Evaluator::set_measured`]); `None` = the analytic base BRDF (or a file not
+    /// loaded yet).
+    pub measured: Option<Arc<MeasuredBrdf>>,
 }
 
 impl Evaluator {
@@ -124,6 +129,7 @@ impl Evaluator {
             slope_color: material.terms.slope.as_ref().map(|t| t.color.compiled()),
             image_slopes,
             environment,
+            measured: None,
         })
     }
 
@@ -142,6 +148,26 @@ impl Evaluator {
     /// [`Evaluator::set_environment_radiance`] from an equirectangular map.
     pub fn set_environment_map(&mut self, map: &EquirectMap) {
         self.set_environment_radiance(&map.sh());
+    }
+
+    /// Use a measured base BRDF: ground truth and naive shade facets with its table, the filtered
+    /// views with its fit, whose σ becomes `material.brdf`'s roughness (with albedo and F0 1, the
+    /// fit's per-channel kd and F0 applied by [`Evaluator::channel_weights`]); see
+    /// [`crate::material::measured`]. Ignored when the material names no measured file.
+    pub fn set_measured(&mut self, measured: Arc<MeasuredBrdf>) {
+        let Some(path) = self.material.brdf.measured.clone() else {
+            return;
+        };
+        self.material.brdf = measured.fitted_base(Some(path));
+        self.measured = Some(measured);
+    }
+
+    /// How the base BRDF's albedo and F0 become colours: the measured BRDF's fit, or grey and
+    /// white for the analytic base BRDF.
+    pub fn channel_weights(&self) -> ChannelWeights {
+        self.measured
+            .as_ref()
+            .map_or(ChannelWeights::ANALYTIC, |m| m.channel_weights())
     }
 
     /// Colour of a point of the explicit surface with driver value f.

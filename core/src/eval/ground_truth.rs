@@ -7,7 +7,6 @@ use crate::driver::field::DriverField;
 use crate::eval::{Estimate, Evaluator, FootprintQuery};
 use crate::math::gaussian::cholesky;
 use crate::math::random::standard_normal;
-use crate::microfacet::slopes::SlopeCov;
 use crate::microfacet::slopes::normal_of;
 use crate::scene::bound_grid::BoundGrid;
 use crate::scene::march::March;
@@ -36,7 +35,10 @@ impl Evaluator {
     ///
     /// [`BaseBrdf::specular_peak`]: crate::microfacet::brdf::BaseBrdf::specular_peak
     pub fn glint_rays(&self, cfg: &FootprintQuery, mean: [f64; 3], precision: f64) -> f64 {
-        let bound = self.material.lighting.sun * self.material.brdf.specular_peak(cfg.wo, cfg.wi);
+        // A measured BRDF: its fit's lobe, times its largest channel weight.
+        let weight = self.channel_weights().f0.into_iter().fold(0.0, f64::max);
+        let bound =
+            self.material.lighting.sun * self.material.brdf.specular_peak(cfg.wo, cfg.wi) * weight;
         if !(bound > 0.0) {
             return 0.0;
         }
@@ -173,10 +175,6 @@ impl Evaluator {
         }
         let v = if lit && sees_light() { 1.0 } else { 0.0 };
         let aff = self.material.terms.affine(self.color_at(f));
-        let spec = self
-            .material
-            .brdf
-            .specular_with(n, wo, wi, SlopeCov::default());
-        self.radiance(aff, aff, &self.point_shading(n, wi, frame), v, spec)
+        self.facet_radiance(aff, n, wo, wi, v, frame)
     }
 }

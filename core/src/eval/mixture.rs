@@ -34,7 +34,7 @@
 
 use crate::driver::conditional_slopes::ConditionalSlopes;
 use crate::driver::histogram::DriverHistogram;
-use crate::eval::shading::SlopeShading;
+use crate::eval::shading::{SlopeShading, specular_tint};
 use crate::eval::{Evaluator, FootprintQuery};
 use crate::material::color_terms::Affine;
 use crate::material::{ColorModel, ColorSource};
@@ -167,6 +167,7 @@ impl Evaluator {
             .collect();
         // G(z_j) = exp(−Σ_{i>j} Λ_i w_i/Φ(z_i) − ½Λ_j w_j/Φ(z_j)): the integral from the top down.
         let kd = m.brdf.albedo * FRAC_1_PI;
+        let w = self.channel_weights();
         let sun = m.lighting.sun;
         let (mut acc_o, mut acc) = (0.0, 0.0);
         let (mut num, mut den) = ([0.0f64; 3], 0.0f64);
@@ -182,6 +183,7 @@ impl Evaluator {
             acc += 2.0 * half;
             den += node.w * g1 * node.s_o;
             let (a, k, sh) = (node.color.a, node.color.k, &node.shading);
+            let tint = specular_tint(&w, &node.color, sh);
             for c in 0..3 {
                 let sun_part = sun * (a[c] * sh.cos + k[c] * sh.cs_cos[c]);
                 let env_part = a[c] * sh.env[c] + k[c] * sh.cs_env[c];
@@ -191,7 +193,9 @@ impl Evaluator {
                 } else {
                     0.0
                 };
-                num[c] += node.w * (g2 * (kd * sun_part + spec) + g1 * kd * env_part);
+                num[c] += node.w
+                    * (g2 * (kd * w.kd[c] * sun_part + spec * tint[c])
+                        + g1 * kd * w.kd[c] * env_part);
             }
         }
         if !(den > 0.0) {

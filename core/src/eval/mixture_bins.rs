@@ -23,7 +23,7 @@
 
 use crate::driver::conditional_slopes::ImageSlopes;
 use crate::eval::query::FootprintStats;
-use crate::eval::shading::SlopeShading;
+use crate::eval::shading::{SlopeShading, specular_tint};
 use crate::eval::{Evaluator, FootprintQuery};
 use crate::material::transfer::TransferFunction;
 use crate::math::special::norm_quantile;
@@ -141,6 +141,7 @@ impl Evaluator {
         let sun_lit = wi.z > 0.0 && cfg.wi.z > 0.0;
         let b = &m.brdf;
         let kd = b.albedo * FRAC_1_PI;
+        let weights = self.channel_weights();
         let sun = m.lighting.sun * sun_visible;
         let points = bin_slope_points(m.filtering.slope_points, m.terms.slope.is_some());
         let (mut above_o, mut above) = (0.0, 0.0);
@@ -163,8 +164,10 @@ impl Evaluator {
                 (0.0, 0.0)
             };
             let c = m.terms.affine(bin.color);
+            let tint = specular_tint(&weights, &c, &s);
             for ch in 0..3 {
-                num[ch] += v * (kd * (c.a[ch] * s.cos + c.k[ch] * s.cs_cos[ch]) + spec)
+                let kd = kd * weights.kd[ch];
+                num[ch] += v * (kd * (c.a[ch] * s.cos + c.k[ch] * s.cs_cos[ch]) + spec * tint[ch])
                     + w1 * kd * (c.a[ch] * s.env[ch] + c.k[ch] * s.cs_env[ch]);
             }
         }

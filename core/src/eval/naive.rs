@@ -1,10 +1,9 @@
 //! Naive MIP [HNPN14 Sec. 4, Sec. 9]: the colour map of the footprint-filtered driver `C(f̄)`,
-//! shaded by the base BRDF at the filtered (mean-slope) normal; no masking, no shadowing. What a
-//! mip-mapped pipeline does.
+//! shaded by the base BRDF (or a measured one's table) at the filtered (mean-slope) normal; no
+//! masking, no shadowing. What a mip-mapped pipeline does.
 
 use crate::eval::query::lit;
 use crate::eval::{Evaluator, FootprintQuery};
-use crate::microfacet::slopes::SlopeCov;
 use crate::microfacet::slopes::normal_of;
 use glam::DMat3;
 
@@ -26,11 +25,7 @@ impl Evaluator {
         let loc = self.footprint_stats(cfg);
         let n = normal_of(loc.stats.slope_mean);
         let aff = self.material.terms.affine(self.color_at(loc.driver.mean));
-        let spec = self
-            .material
-            .brdf
-            .specular_with(n, cfg.wo, cfg.wi, SlopeCov::default());
         let v = sun_visible * lit(cfg, n);
-        self.radiance(aff, aff, &self.point_shading(n, cfg.wi, frame), v, spec)
+        self.facet_radiance(aff, n, cfg.wo, cfg.wi, v, frame)
     }
 }

@@ -4,6 +4,7 @@
 
 use crate::eval::Evaluator;
 use crate::material::color_terms::Affine;
+use crate::material::measured::ChannelWeights;
 use crate::microfacet::slopes::SlopeCov;
 use crate::microfacet::visible_slopes::visible_slope_nodes;
 use glam::{DMat3, DVec2, DVec3};
@@ -111,8 +112,10 @@ impl Evaluator {
 
     /// Radiance from the combined colour `A + K ⊙ C_s` (`sun_color` under the directional light,
     /// `env_color` under the environment, which can differ because D_h differs), the shading inputs,
-    /// the directional light's visibility `v` (shadowing) and the uncoloured specular:
-    /// `ρ_d/π·(sun·v·(A⊙E[cos] + K⊙E[C_s cos]) + A⊙E[E_env] + K⊙E[C_s⊙E_env]) + sun·v·spec`.
+    /// the directional light's visibility `v` (shadowing) and the specular lobe `spec`:
+    /// `ρ_d/π·w_d⊙(sun·v·(A⊙E[cos] + K⊙E[C_s cos]) + A⊙E[E_env] + K⊙E[C_s⊙E_env]) + sun·v·spec·w_s`,
+    /// with the channel weights w_d, w_s of [`Evaluator::channel_weights`] (1 for the analytic
+    /// base BRDF; a measured BRDF's fit, its lobe tinted by [`Evaluator::specular_tint`]).
     pub(super) fn radiance(
         &self,
         sun_color: Affine,
@@ -121,13 +124,70 @@ impl Evaluator {
         v: f64,
         spec: f64,
     ) -> [f64; 3] {
+        let w = self.channel_weights();
         let sun = self.material.lighting.sun * v;
         let kd = self.material.brdf.albedo * FRAC_1_PI;
+        let tint = specular_tint(&w, &sun_color, s);
         [0, 1, 2].map(|c| {
-            kd * (sun * (sun_color.a[c] * s.cos + sun_color.k[c] * s.cs_cos[c])
-                + env_color.a[c] * s.env[c]
-                + env_color.k[c] * s.cs_env[c])
-                + sun * spec
+            kd * w.kd[c]
+                * (sun * (sun_color.a[c] * s.cos + sun_color.k[c] * s.cs_cos[c])
+                    + env_color.a[c] * s.env[c]
+                    + env_color.k[c] * s.cs_env[c])
+                + sun * spec * tint[c]
         })
     }
+
+    /// Radiance of one facet of unit normal n (local frame, as ωo and ωi; `frame` to the world)
+    /// with colour terms `color` and light visibility v: the base BRDF at n ([`Evaluator::radiance`]
+    /// with the facet's lobe), or, with a measured BRDF, its table in the facet's frame tinted by
+    /// the facet's colour, `sun·v·(A + K⊙C_s)⊙ρ(ωi, ωo)(n·ωi)⁺`, plus the environment on the fit's
+    /// diffuse part ([`crate::material::measured`]). Ground truth's explicit facets and the naive
+    /// view's filtered normal.
+    pub(super) fn facet_radiance(
+        &self,
+        color: Affine,
+        n: DVec3,
+        wo: DVec3,
+        wi: DVec3,
+        v: f64,
+        frame: &DMat3,
+    ) -> [f64; 3] {
+        let s = self.point_shading(n, wi, frame);
+        let Some(m) = &self.measured else {
+            let spec = self
+                .material
+                .brdf
+                .specular_with(n, wo, wi, SlopeCov::default());
+            return self.radiance(color, color, &s, v, spec);
+        };
+        let rho = if v > 0.0 {
+            m.eval_facet(n, wi, wo)
+        } else {
+            [0.0; 3]
+        };
+        let sun = self.material.lighting.sun * v;
+        let kd = self.material.brdf.albedo * FRAC_1_PI;
+        let w = m.channel_weights();
+        [0, 1, 2].map(|c| {
+            sun * (color.a[c] * s.cos + color.k[c] * s.cs_cos[c]) * rho[c]
+                + kd * w.kd[c] * (color.a[c] * s.env[c] + color.k[c] * s.cs_env[c])
+        })
+    }
+}
+
+/// Per-channel weight of the specular lobe: the channel weight w_s, times, for a tinted lobe (a
+/// measured BRDF), the mean colour of the lit facets `A + K⊙E[C_s cos]/E[cos]` (A where no facet
+/// is lit: the lobe is 0 there anyway).
+pub(super) fn specular_tint(w: &ChannelWeights, color: &Affine, s: &SlopeShading) -> [f64; 3] {
+    [0, 1, 2].map(|c| {
+        if !w.tint_specular {
+            return w.f0[c];
+        }
+        let cs = if s.cos > 0.0 {
+            s.cs_cos[c] / s.cos
+        } else {
+            0.0
+        };
+        w.f0[c] * (color.a[c] + color.k[c] * cs)
+    })
 }

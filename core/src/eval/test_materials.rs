@@ -32,6 +32,7 @@ pub(crate) fn gaussian_material() -> Material {
             albedo: 1.0,
             specular: 0.0,
             roughness: 0.1,
+            measured: None,
         },
         ..Material::default()
     }

@@ -61,11 +61,14 @@ pub enum Feature {
     /// footprint's (f̄, σ_f) to Gaussian space and the colour table over it
     /// ([`crate::driver::histogram`]; needs an image and a gradient colour map).
     ImageHistogram,
+    /// A measured base BRDF (a MERL table in the data buffer): ground truth and naive look
+    /// facets up in it ([`crate::material::measured`]).
+    Measured,
 }
 
 impl Feature {
     /// Every feature, in a fixed order.
-    pub const ALL: [Feature; 14] = [
+    pub const ALL: [Feature; 15] = [
         Feature::NoiseDriver,
         Feature::ImageDriver,
         Feature::DriverColor,
@@ -80,6 +83,7 @@ impl Feature {
         Feature::SlopeColor,
         Feature::Environment,
         Feature::ImageHistogram,
+        Feature::Measured,
     ];
 
     /// The name used in shader directives (`//#if relief`), the CLI and JSON.
@@ -99,6 +103,7 @@ impl Feature {
             Feature::SlopeColor => "slope_color",
             Feature::Environment => "environment",
             Feature::ImageHistogram => "image_histogram",
+            Feature::Measured => "measured",
         }
     }
 
@@ -212,10 +217,14 @@ impl FeatureSet {
             )
             .with(Feature::TransferMixture, m.transfer_mixture())
             .with(Feature::Relief, relief)
-            .with(Feature::Specular, m.brdf.specular > 0.0)
+            .with(
+                Feature::Specular,
+                m.brdf.specular > 0.0 || m.brdf.measured.is_some(),
+            )
             .with(Feature::SlopeColor, m.terms.slope.is_some())
             .with(Feature::Environment, m.lighting.environment.is_some())
             .with(Feature::ImageHistogram, colour_model && m.image_histogram())
+            .with(Feature::Measured, m.brdf.measured.is_some())
     }
 
     /// The features a material needs in a scene with this object and light (unit direction
@@ -291,6 +300,7 @@ impl FeatureSet {
                         }
                     }
                     Feature::Specular => "the specular weight is 0",
+                    Feature::Measured => "the base BRDF is analytic (no measured file)",
                     Feature::Curved => "the scene is the plane",
                     Feature::SlopeColor => "the material has no slope colour term",
                     Feature::Environment => "the lighting has no environment",

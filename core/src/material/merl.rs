@@ -290,6 +290,12 @@ impl MerlBrdf {
         }
     }
 
+    /// The table: red, green, blue channels of [`ENTRIES`] each, indexed as the file
+    /// ([`entry`]), in reflectance per steradian (unmeasured entries 0).
+    pub fn values(&self) -> &[f32] {
+        &self.values
+    }
+
     /// Entries the file marked unmeasured (read as 0), per channel.
     pub fn unmeasured(&self) -> [usize; 3] {
         self.unmeasured

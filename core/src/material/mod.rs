@@ -17,6 +17,7 @@ pub mod color_terms;
 pub mod colormap;
 pub mod environment;
 pub mod features;
+pub mod measured;
 pub mod merl;
 pub mod merl_fit;
 pub mod preconvolved;
@@ -245,6 +246,7 @@ impl Default for Material {
                 albedo: 1.0,
                 specular: 0.04,
                 roughness: 0.15,
+                measured: None,
             },
             filtering: Filtering::default(),
             terms: ColorTerms::default(),

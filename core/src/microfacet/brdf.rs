@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_1_PI, TAU};
 
 /// Base BRDF parameters.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BaseBrdf {
     /// Diffuse albedo scale applied to the colour map's linear RGB, in [0, 1].
@@ -28,6 +28,11 @@ pub struct BaseBrdf {
     pub specular: f64,
     /// Base roughness σ_n0: standard deviation of the base BRDF's facet slopes (Beckmann α = √2 σ_n0).
     pub roughness: f64,
+    /// A measured BRDF (a MERL `.binary` file, its path relative to the preset's folder) that
+    /// replaces this analytic one: albedo, specular and roughness are then unused, the views take
+    /// the table or its fit ([`crate::material::measured`]). `None`: the analytic BRDF.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub measured: Option<String>,
 }
 
 impl Default for BaseBrdf {
@@ -36,6 +41,7 @@ impl Default for BaseBrdf {
             albedo: 1.0,
             specular: 0.0,
             roughness: 0.2,
+            measured: None,
         }
     }
 }
@@ -161,6 +167,7 @@ mod tests {
             albedo: 0.5,
             specular: 0.6,
             roughness: 0.04,
+            measured: None,
         };
         for (tv, tl, az) in [(1.31, 0.52, 0.0), (0.2, 0.9, 2.5), (1.5, 1.5, 3.1)] {
             let (wo, wi) = (direction(tv, 0.0), direction(tl, az));
@@ -195,6 +202,7 @@ mod tests {
             albedo: 0.8,
             specular: 0.0,
             roughness: 0.1,
+            measured: None,
         };
         let wi = DVec3::new(0.6, 0.0, 0.8);
         assert!((b.diffuse(DVec3::Z, wi) - 0.8 * 0.8 / std::f64::consts::PI).abs() < 1e-15);
@@ -211,6 +219,7 @@ mod tests {
             albedo: 0.0,
             specular: 1.0,
             roughness: 0.15,
+            measured: None,
         };
         let sigma = SlopeCov::from_std(0.2, 0.1);
         let wo = DVec3::new(0.3, 0.1, 0.9).normalize();

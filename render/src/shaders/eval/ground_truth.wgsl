@@ -45,7 +45,5 @@ fn shade_hit(f: f32, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, p: vec3<f32>) -
 
 // The end of Evaluator::shade_hit: colour terms and radiance at a facet with light visibility v.
 fn shade_point(f: f32, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, v: f32) -> vec3<f32> {
-    let aff = affine(color_at(f));
-    let spec = specular_with(n, wo, wi, vec3<f32>(0.0));
-    return radiance(aff, aff, point_shading(n, wi), v, spec);
+    return facet_radiance(affine(color_at(f)), n, wo, wi, v);
 }

@@ -77,7 +77,7 @@ fn filtered_bins(loc: FootprintStats, wo_w: vec3<f32>, wi_w: vec3<f32>, wo: vec3
         }
     }
     let sun_lit = wi.z > 0.0 && wi_w.z > 0.0;
-    let kd = params.albedo * FRAC_1_PI;
+    let kd = params.albedo * FRAC_1_PI * params.kd_rgb;
     let sun = params.sun * sun_visible;
     var above_o = 0.0;
     var above = 0.0;
@@ -109,7 +109,7 @@ fn filtered_bins(loc: FootprintStats, wo_w: vec3<f32>, wi_w: vec3<f32>, wo: vec3
         }
         let c = affine(bin.color);
         let s = sums.s;
-        num = num + v * (kd * (c.a * s.cos + c.k * s.cs_cos) + vec3<f32>(spec)) + w1 * kd * (c.a * s.env + c.k * s.cs_env);
+        num = num + v * (kd * (c.a * s.cos + c.k * s.cs_cos) + spec * specular_tint(c, s)) + w1 * kd * (c.a * s.env + c.k * s.cs_env);
     }
     if (!(den > 0.0)) {
         return vec3<f32>(0.0);

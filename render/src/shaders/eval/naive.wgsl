@@ -5,7 +5,5 @@
 fn eval_naive(x0: vec2<f32>, fp: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, sun_visible: f32) -> vec3<f32> {
     let loc = footprint_stats(x0, fp);
     let n = normal_of(loc.stats.slope_mean);
-    let aff = affine(color_at(loc.driver.mean));
-    let spec = specular_with(n, wo, wi, vec3<f32>(0.0));
-    return radiance(aff, aff, point_shading(n, wi), sun_visible * lit(wi, n), spec);
+    return facet_radiance(affine(color_at(loc.driver.mean)), n, wo, wi, sun_visible * lit(wi, n));
 }

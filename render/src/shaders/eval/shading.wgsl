@@ -59,11 +59,43 @@ fn point_shading(n: vec3<f32>, wi: vec3<f32>) -> SlopeShading {
     return r;
 }
 
-// Evaluator::radiance.
+// Evaluator::radiance (with the channel weights kd_rgb, f0_rgb).
 fn radiance(sun_color: Affine, env_color: Affine, s: SlopeShading, v: f32, spec: f32) -> vec3<f32> {
     let sun = params.sun * v;
-    let kd = params.albedo * FRAC_1_PI;
-    return kd * (sun * (sun_color.a * s.cos + sun_color.k * s.cs_cos) + env_color.a * s.env + env_color.k * s.cs_env) + vec3<f32>(sun * spec);
+    let kd = params.albedo * FRAC_1_PI * params.kd_rgb;
+    return kd * (sun * (sun_color.a * s.cos + sun_color.k * s.cs_cos) + env_color.a * s.env + env_color.k * s.cs_env) + sun * spec * specular_tint(sun_color, s);
+}
+
+// shading::specular_tint: the lobe's channel weights, times the lit facets' mean colour for a
+// measured BRDF.
+fn specular_tint(color: Affine, s: SlopeShading) -> vec3<f32> {
+    if (params.measured == 0u) {
+        return params.f0_rgb;
+    }
+    var cs = vec3<f32>(0.0);
+    if (s.cos > 0.0) {
+        cs = s.cs_cos / s.cos;
+    }
+    return params.f0_rgb * (color.a + color.k * cs);
+}
+
+// Evaluator::facet_radiance (the frame is shading_frame): the base BRDF at facet n, or a measured
+// BRDF's table in the facet's frame tinted by its colour.
+fn facet_radiance(color: Affine, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, v: f32) -> vec3<f32> {
+    let s = point_shading(n, wi);
+//#if measured
+    if (params.measured != 0u) {
+        var rho = vec3<f32>(0.0);
+        if (v > 0.0) {
+            rho = measured_eval_facet(n, wi, wo);
+        }
+        let sun = params.sun * v;
+        let kd = params.albedo * FRAC_1_PI * params.kd_rgb;
+        return sun * (color.a * s.cos + color.k * s.cs_cos) * rho + kd * (color.a * s.env + color.k * s.cs_env);
+    }
+//#endif
+    let spec = specular_with(n, wo, wi, vec3<f32>(0.0));
+    return radiance(color, color, s, v, spec);
 }
 
 fn has_environment() -> bool {

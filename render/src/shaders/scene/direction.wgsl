@@ -1,7 +1,7 @@
 // Mirror of `core/src/scene/direction.rs`, function for function under the same names.
 // `//#if feature` blocks are stripped by render/src/specialize.rs when a scene does not use the feature.
 
-//#if relief
+//#if relief|measured
 // direction::basis (Duff et al. 2017).
 fn basis_t(n: vec3<f32>) -> vec3<f32> {
     let sign = select(-1.0, 1.0, n.z >= 0.0);
