@@ -294,10 +294,15 @@ gpu_struct! {
         kd_rgb: [f32; 3] => "vec3<f32>",
         /// Offset of the measured table: red, green, blue channels of `MERL_ENTRIES` each.
         merl_offset: u32 => "u32",
-        /// Specular weight per channel (core's `ChannelWeights::f0`; 1 for the analytic BRDF).
-        f0_rgb: [f32; 3] => "vec3<f32>",
+        /// Offset of a measured BRDF's fitted lobes (core's `merl_fit::Lobe`: σ, weight RGB,
+        /// Fresnel weight RGB; 7 floats each).
+        lobe_offset: u32 => "u32",
+        /// Number of fitted lobes (0 for the analytic BRDF).
+        lobe_count: u32 => "u32",
         /// Padding to WGSL's 16-byte struct size.
         pad3: u32 => "u32",
+        /// Padding to WGSL's 16-byte struct size.
+        pad4: u32 => "u32",
     }
 }
 

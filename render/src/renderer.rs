@@ -668,6 +668,15 @@ pub fn material_data_for(
         base.measured = 1;
         data.extend(measured.table.values());
         mark(&data, start, "measured BRDF table");
+        let start = data.len();
+        base.lobe_offset = data.len() as u32;
+        base.lobe_count = measured.fit.lobes.len() as u32;
+        for l in &measured.fit.lobes {
+            data.push(l.sigma as f32);
+            data.extend(l.weight.map(|v| v as f32));
+            data.extend(l.fresnel.map(|v| v as f32));
+        }
+        mark(&data, start, "measured BRDF's fitted lobes");
     }
     if let TransferFunction::Curve(c) = &m.heights.transfer {
         let p = c.moment_poly();
@@ -692,7 +701,6 @@ pub fn material_data_for(
     base.sigma_h = s.sigma_h as f32;
     let weights = prepared.channel_weights();
     base.kd_rgb = weights.kd.map(|v| v as f32);
-    base.f0_rgb = weights.f0.map(|v| v as f32);
     base.albedo = m.brdf.albedo as f32;
     base.specular = m.brdf.specular as f32;
     base.roughness = m.brdf.roughness as f32;

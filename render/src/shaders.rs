@@ -43,6 +43,7 @@ pub const MATERIAL_FILES: &[(&str, &str)] = wgsl_files![
     "material/transfer.wgsl",
     "material/color_terms.wgsl",
     "material/merl.wgsl",
+    "material/merl_fit.wgsl",
     "material/measured.wgsl",
     "driver/footprint.wgsl",
     "driver/noise.wgsl",

@@ -63,6 +63,8 @@ const MIRRORS: &[(&str, &str, &str, &str)] = &[
     ("material/preconvolved.wgsl", "table_sample", "material/preconvolved.rs", "sample"),
     ("material/transfer.wgsl", "transfer_eval", "material/transfer.rs", "eval"),
     ("material/merl.wgsl", "merl_eval", "material/merl.rs", "eval"),
+    ("microfacet/brdf.wgsl", "specular_lobe", "microfacet/brdf.rs", "specular_with"),
+    ("microfacet/brdf.wgsl", "filtered_lobe", "microfacet/brdf.rs", "filtered_specular"),
     ("material/measured.wgsl", "measured_eval_facet", "material/measured.rs", "eval_facet"),
     ("material/transfer.wgsl", "transfer_moments", "eval/compiled.rs", "moments"),
     ("driver/noise.wgsl", "wave_term", "driver/noise.rs", "value_and_gradient"),

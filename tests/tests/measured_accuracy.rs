@@ -6,7 +6,9 @@
 //!
 //! `cargo test -p lodestone-tests --release --test measured_accuracy -- --ignored --nocapture`
 //! prints the full grid; the default run checks a few configurations against the bounds measured
-//! there.
+//! there. Measured 2026-12-03, 200 000 rays: plastic filtered −17% to +2% (mean |e| 5.7%), gold
+//! −49% to +14% (mean 17%), both worst at 75° with the light on the viewer's side, too dark;
+//! naive 20–930% off.
 
 use glam::DVec3;
 use lodestone_core::eval::{Evaluator, FootprintQuery};
@@ -86,8 +88,10 @@ fn measured_grid() {
         let p = evaluator(table);
         let fit = &p.measured.as_ref().unwrap().fit;
         eprintln!(
-            "{name}: fit kd {:.3?} F0 {:.3?} σ {:.3}, relative error {:.3?}",
-            fit.kd, fit.f0, fit.sigma, fit.relative_error
+            "{name}: fit kd {:.3?}, {} lobes, relative error {:.3?}",
+            fit.kd,
+            fit.lobes.len(),
+            fit.relative_error
         );
         for view in [0.0, 45.0, 60.0, 75.0] {
             for light in [(0.0, 0.0), (30.0, 0.0), (30.0, 180.0), (60.0, 180.0)] {
@@ -102,5 +106,27 @@ fn measured_grid() {
                 );
             }
         }
+    }
+}
+
+/// The red plastic where the fit and its facet-frame correction hold (full grid, 200 000 rays:
+/// +0.7% at 0°, +1.4% at 45° and −1.9% at 60° with the light 30° opposite): the filtered view within
+/// 5% of the truth that looks every facet up in the table, where naive is 22–390% off.
+#[test]
+fn the_filtered_view_follows_a_measured_plastic() {
+    let (_, table) = tables().swap_remove(1);
+    let p = evaluator(table);
+    for (view, light) in [
+        (0.0, (0.0, 0.0)),
+        (45.0, (30.0, 180.0)),
+        (60.0, (30.0, 180.0)),
+    ] {
+        let (f, n, se) = errors(&p, view, light, 20_000);
+        eprintln!("view {view}° light {light:?}: filtered {f:+.4}, naive {n:+.4}, s.e. {se:.4}");
+        assert!(
+            f.abs() < 0.05,
+            "view {view}° light {light:?}: filtered {f:+.4}"
+        );
+        assert!(n.abs() > 0.2, "view {view}° light {light:?}: naive {n:+.4}");
     }
 }

@@ -258,7 +258,8 @@ impl Inspector {
             .on_hover_text(
                 "Analytic: Lambert plus a slope-space Beckmann lobe. Measured: a MERL isotropic \
                  BRDF table (.binary, 90×90×180 half/difference angles) that ground truth and naive \
-                 look up per facet; the filtered views use its Lambert-plus-Beckmann fit. The colour \
+                 look up per facet; the filtered views use its fit, Lambert plus Beckmann lobes \
+                 with a Schlick Fresnel term each (merl_fit.rs). The colour \
                  map tints the whole measured BRDF (white shows it as measured). Drop a .binary file \
                  on the window to use it",
             );
@@ -285,9 +286,18 @@ impl Inspector {
             });
             match &self.measured_fit {
                 Some(f) => {
+                    let lobes: Vec<String> =
+                        f.lobes.iter().map(|l| format!("{:.3}", l.sigma)).collect();
                     ui.label(format!(
-                        "Fit for the filtered views: kd ({:.3}, {:.3}, {:.3}), F0 ({:.3}, {:.3}, {:.3}), σ {:.3}",
-                        f.kd[0], f.kd[1], f.kd[2], f.f0[0], f.f0[1], f.f0[2], f.sigma
+                        "Fit for the filtered views: kd ({:.3}, {:.3}, {:.3}), lobes of σ {}",
+                        f.kd[0],
+                        f.kd[1],
+                        f.kd[2],
+                        if lobes.is_empty() {
+                            "(none)".to_owned()
+                        } else {
+                            lobes.join(", ")
+                        }
                     ));
                     let worst = f.relative_error.iter().copied().fold(0.0, f64::max);
                     let text = format!(

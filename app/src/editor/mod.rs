@@ -433,7 +433,7 @@ impl eframe::App for EditorApp {
                         // otherwise).
                         let _ = self.load_files(&ctx);
                     }
-                    self.inspector.measured_fit = self.doc.measured().map(|m| m.fit);
+                    self.inspector.measured_fit = self.doc.measured().map(|m| m.fit.clone());
                     self.inspector.driver_image = self.doc.driver_image();
                     self.inspector.driver_shape = self
                         .inspector

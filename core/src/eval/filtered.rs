@@ -12,7 +12,6 @@
 use crate::driver::field::DriverField;
 use crate::eval::{Evaluator, FootprintQuery};
 use crate::material::transfer::TransferFunction;
-use crate::microfacet::brdf::filtered_specular;
 use crate::microfacet::effective_height::height_moments;
 use crate::microfacet::masking_shadowing::G2;
 use crate::microfacet::slope_density::{NoiseSlopes, sinusoid_density_ratio};
@@ -91,18 +90,17 @@ impl Evaluator {
         } else {
             0.0
         };
-        let brdf = &self.material.brdf;
         // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
         let mean = loc.stats.slope_mean;
         let shading = self.visible_shading(mean, &sigma, cfg.wo, cfg.wi, frame);
         let lit = sun_visible * vbar;
-        let mut spec =
-            filtered_specular(brdf.specular, brdf.roughness, mean, &sigma, cfg.wo, cfg.wi);
+        let mut spec = self.specular_lobes(mean, &sigma, cfg.wo, cfg.wi);
         // The density ratio scales only the sun's specular term: where the sun does not reach the
         // pixel (shadowed, behind the mean plane, or no sun) or the lobe is 0, it changes nothing,
         // and its saddle point is the costliest part of the pixel (issue #15).
-        if spec > 0.0 && lit > 0.0 && self.material.lighting.sun != 0.0 {
-            spec *= self.lobe_density_ratio(cfg, mean);
+        if spec.iter().any(|v| *v > 0.0) && lit > 0.0 && self.material.lighting.sun != 0.0 {
+            let r = self.lobe_density_ratio(cfg, mean);
+            spec = spec.map(|v| v * r);
         }
         self.radiance(sun_color, env_color, &shading, lit, spec)
     }
@@ -112,13 +110,15 @@ impl Evaluator {
     /// The noise's exact unresolved slope density over the Gaussian the lobe assumes, at the half
     /// vector's slope relative to the footprint's mean ([`sinusoid_density_ratio`], with the base
     /// roughness as the added Gaussian): 1 for image drivers, transfer curves (their slopes are
-    /// not the waves' alone), without specular and with `filtering.noise_slopes: Gaussian`.
+    /// not the waves' alone), without specular, with `filtering.noise_slopes: Gaussian`, and for a
+    /// measured BRDF (its fitted lobes keep the Gaussian).
     pub fn lobe_density_ratio(&self, cfg: &FootprintQuery, mean: DVec2) -> f64 {
         let m = &self.material;
         let DriverField::Noise(noise) = &self.surface.driver else {
             return 1.0;
         };
         if m.brdf.specular <= 0.0
+            || self.measured.is_some()
             || m.filtering.noise_slopes == NoiseSlopes::Gaussian
             || !matches!(m.heights.transfer, TransferFunction::Identity)
             || cfg.wo.z <= 0.0

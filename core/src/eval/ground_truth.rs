@@ -35,10 +35,28 @@ impl Evaluator {
     ///
     /// [`BaseBrdf::specular_peak`]: crate::microfacet::brdf::BaseBrdf::specular_peak
     pub fn glint_rays(&self, cfg: &FootprintQuery, mean: [f64; 3], precision: f64) -> f64 {
-        // A measured BRDF: its fit's lobe, times its largest channel weight.
-        let weight = self.channel_weights().f0.into_iter().fold(0.0, f64::max);
-        let bound =
-            self.material.lighting.sun * self.material.brdf.specular_peak(cfg.wo, cfg.wi) * weight;
+        // A measured BRDF: the peaks of its fitted lobes, each at its largest channel weight.
+        let peak = match &self.measured {
+            None => self.material.brdf.specular_peak(cfg.wo, cfg.wi),
+            Some(m) => m
+                .fit
+                .lobes
+                .iter()
+                .map(|l| {
+                    let w = (0..3)
+                        .map(|c| l.weight[c] + l.fresnel[c])
+                        .fold(0.0, f64::max);
+                    let lobe = crate::microfacet::brdf::BaseBrdf {
+                        albedo: 0.0,
+                        specular: 1.0,
+                        roughness: l.sigma,
+                        measured: None,
+                    };
+                    w * lobe.specular_peak(cfg.wo, cfg.wi)
+                })
+                .sum(),
+        };
+        let bound = self.material.lighting.sun * peak;
         if !(bound > 0.0) {
             return 0.0;
         }

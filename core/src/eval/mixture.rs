@@ -40,7 +40,6 @@ use crate::material::color_terms::Affine;
 use crate::material::{ColorModel, ColorSource};
 use crate::math::special::{norm_cdf, norm_pdf};
 use crate::microfacet::attribute::attribute;
-use crate::microfacet::brdf::filtered_specular;
 use crate::microfacet::masking_shadowing::{G2, azimuth_difference};
 use crate::microfacet::smith::lambda;
 use crate::microfacet::visible_slopes::visible_slope_nodes;
@@ -92,7 +91,7 @@ impl Evaluator {
             // Unnormalized visible-slope sums: the shading inputs weighted by ⟨ωo·m⟩⁺/m_z.
             shading: SlopeShading,
             s_o: f64,
-            spec: f64,
+            spec: [f64; 3],
         }
         // An image driver: its values T⁻¹(μ_G + σ_G z) where it keeps its histogram, and its
         // slopes' dependence on the value ([`ConditionalSlopes`]), normalized over the footprint.
@@ -153,7 +152,6 @@ impl Evaluator {
                         acc.cs_env[c] += w * p.cs_env[c];
                     }
                 });
-                let b = &m.brdf;
                 Node {
                     w: norm_pdf(z) / total,
                     color: m.terms.affine(color_of(f)),
@@ -161,7 +159,7 @@ impl Evaluator {
                     l_total: ms.total,
                     shading: acc,
                     s_o,
-                    spec: filtered_specular(b.specular, b.roughness, mean, &cov, wo, wi),
+                    spec: self.specular_lobes(mean, &cov, wo, wi),
                 }
             })
             .collect();
@@ -189,7 +187,7 @@ impl Evaluator {
                 let env_part = a[c] * sh.env[c] + k[c] * sh.cs_env[c];
                 // The node's lobe per unit of its visible area (filtered_specular divides by So).
                 let spec = if sun_up {
-                    sun * node.s_o * node.spec
+                    sun * node.s_o * node.spec[c]
                 } else {
                     0.0
                 };

@@ -27,7 +27,6 @@ use crate::eval::shading::{SlopeShading, specular_tint};
 use crate::eval::{Evaluator, FootprintQuery};
 use crate::material::transfer::TransferFunction;
 use crate::math::special::norm_quantile;
-use crate::microfacet::brdf::filtered_specular;
 use crate::microfacet::height_mixture::{
     BIN_SAMPLES, bin_exponent, bin_masking, bin_slope_points, mixture_edges,
 };
@@ -158,16 +157,17 @@ impl Evaluator {
                 self.visible_shading_sums(mean, &cov, cfg.wo, cfg.wi, frame, points);
             den += w1 * s_o;
             let (v, spec) = if sun_lit {
-                let lobe = filtered_specular(b.specular, b.roughness, mean, &cov, cfg.wo, cfg.wi);
-                (w2 * sun, lobe * s_o)
+                let lobe = self.specular_lobes(mean, &cov, cfg.wo, cfg.wi);
+                (w2 * sun, lobe.map(|l| l * s_o))
             } else {
-                (0.0, 0.0)
+                (0.0, [0.0; 3])
             };
             let c = m.terms.affine(bin.color);
             let tint = specular_tint(&weights, &c, &s);
             for ch in 0..3 {
                 let kd = kd * weights.kd[ch];
-                num[ch] += v * (kd * (c.a[ch] * s.cos + c.k[ch] * s.cs_cos[ch]) + spec * tint[ch])
+                num[ch] += v
+                    * (kd * (c.a[ch] * s.cos + c.k[ch] * s.cs_cos[ch]) + spec[ch] * tint[ch])
                     + w1 * kd * (c.a[ch] * s.env[ch] + c.k[ch] * s.cs_env[ch]);
             }
         }

@@ -5,8 +5,12 @@
 use crate::eval::Evaluator;
 use crate::material::color_terms::Affine;
 use crate::material::measured::ChannelWeights;
+use crate::material::merl_fit::fresnel_factor;
+use crate::microfacet::brdf::{BaseBrdf, filtered_specular};
 use crate::microfacet::slopes::SlopeCov;
+use crate::microfacet::slopes::{normal_of, slope_of};
 use crate::microfacet::visible_slopes::visible_slope_nodes;
+use crate::scene::direction::basis;
 use glam::{DMat3, DVec2, DVec3};
 use std::f64::consts::FRAC_1_PI;
 
@@ -112,17 +116,17 @@ impl Evaluator {
 
     /// Radiance from the combined colour `A + K ⊙ C_s` (`sun_color` under the directional light,
     /// `env_color` under the environment, which can differ because D_h differs), the shading inputs,
-    /// the directional light's visibility `v` (shadowing) and the specular lobe `spec`:
-    /// `ρ_d/π·w_d⊙(sun·v·(A⊙E[cos] + K⊙E[C_s cos]) + A⊙E[E_env] + K⊙E[C_s⊙E_env]) + sun·v·spec·w_s`,
-    /// with the channel weights w_d, w_s of [`Evaluator::channel_weights`] (1 for the analytic
-    /// base BRDF; a measured BRDF's fit, its lobe tinted by [`Evaluator::specular_tint`]).
+    /// the directional light's visibility `v` (shadowing) and the specular lobes `spec` per channel:
+    /// `ρ_d/π·w_d⊙(sun·v·(A⊙E[cos] + K⊙E[C_s cos]) + A⊙E[E_env] + K⊙E[C_s⊙E_env]) + sun·v·spec⊙t`,
+    /// with the diffuse weights w_d of [`Evaluator::channel_weights`] (1 for the analytic base
+    /// BRDF, a measured BRDF's fitted kd) and the tint t of [`specular_tint`].
     pub(super) fn radiance(
         &self,
         sun_color: Affine,
         env_color: Affine,
         s: &SlopeShading,
         v: f64,
-        spec: f64,
+        spec: [f64; 3],
     ) -> [f64; 3] {
         let w = self.channel_weights();
         let sun = self.material.lighting.sun * v;
@@ -133,8 +137,62 @@ impl Evaluator {
                 * (sun * (sun_color.a[c] * s.cos + sun_color.k[c] * s.cs_cos[c])
                     + env_color.a[c] * s.env[c]
                     + env_color.k[c] * s.cs_env[c])
-                + sun * spec * tint[c]
+                + sun * spec[c] * tint[c]
         })
+    }
+
+    /// The specular lobes per channel averaged over the visible slopes N(mean, Σ) (world slope
+    /// space, [`filtered_specular`]): the base lobe, or a measured BRDF's fitted lobes
+    /// `Σ_k filtered_specular(1, σ_k)·(w_k + v_k(1 − ωi·h)⁵)` ([`crate::material::merl_fit`]).
+    pub(super) fn specular_lobes(
+        &self,
+        mean: DVec2,
+        sigma: &SlopeCov,
+        wo: DVec3,
+        wi: DVec3,
+    ) -> [f64; 3] {
+        let Some(m) = &self.measured else {
+            let b = &self.material.brdf;
+            return [filtered_specular(b.specular, b.roughness, mean, sigma, wo, wi); 3];
+        };
+        let f = fresnel_factor(wi, wo);
+        let mut out = [0.0; 3];
+        for l in &m.fit.lobes {
+            let v = filtered_specular(1.0, l.sigma, mean, sigma, wo, wi)
+                * facet_frame_factor(l.sigma, mean, sigma, wo, wi);
+            for c in 0..3 {
+                out[c] += v * (l.weight[c] + l.fresnel[c] * f);
+            }
+        }
+        out
+    }
+
+    /// The specular lobes per channel of one facet of unit normal n (the base lobe's
+    /// [`BaseBrdf::specular_with`], or a measured BRDF's fitted lobes there).
+    pub(super) fn facet_specular(&self, n: DVec3, wo: DVec3, wi: DVec3) -> [f64; 3] {
+        let Some(m) = &self.measured else {
+            let b = &self.material.brdf;
+            return [b.specular_with(n, wo, wi, SlopeCov::default()); 3];
+        };
+        let f = fresnel_factor(wi, wo);
+        // In the facet's own frame, as the table is looked up ([`MeasuredBrdf::eval_facet`]).
+        let (t, b) = basis(n);
+        let local = |w: DVec3| DVec3::new(w.dot(t), w.dot(b), w.dot(n));
+        let (wo, wi) = (local(wo), local(wi));
+        let mut out = [0.0; 3];
+        for l in &m.fit.lobes {
+            let lobe = BaseBrdf {
+                albedo: 0.0,
+                specular: 1.0,
+                roughness: l.sigma,
+                measured: None,
+            };
+            let v = lobe.specular_with(DVec3::Z, wo, wi, SlopeCov::default());
+            for c in 0..3 {
+                out[c] += v * (l.weight[c] + l.fresnel[c] * f);
+            }
+        }
+        out
     }
 
     /// Radiance of one facet of unit normal n (local frame, as ωo and ωi; `frame` to the world)
@@ -154,10 +212,7 @@ impl Evaluator {
     ) -> [f64; 3] {
         let s = self.point_shading(n, wi, frame);
         let Some(m) = &self.measured else {
-            let spec = self
-                .material
-                .brdf
-                .specular_with(n, wo, wi, SlopeCov::default());
+            let spec = self.facet_specular(n, wo, wi);
             return self.radiance(color, color, &s, v, spec);
         };
         let rho = if v > 0.0 {
@@ -175,19 +230,87 @@ impl Evaluator {
     }
 }
 
-/// Per-channel weight of the specular lobe: the channel weight w_s, times, for a tinted lobe (a
-/// measured BRDF), the mean colour of the lit facets `A + K⊙E[C_s cos]/E[cos]` (A where no facet
-/// is lit: the lobe is 0 there anyway).
+/// Tint of the specular lobes: 1 for the analytic base BRDF, and for a measured BRDF (whose
+/// lobes the colour tints, [`crate::material::measured`]) the mean colour of the lit facets,
+/// `A + K⊙E[C_s cos]/E[cos]` (A where no facet is lit: the lobes are 0 there anyway).
 pub(super) fn specular_tint(w: &ChannelWeights, color: &Affine, s: &SlopeShading) -> [f64; 3] {
     [0, 1, 2].map(|c| {
         if !w.tint_specular {
-            return w.f0[c];
+            return 1.0;
         }
         let cs = if s.cos > 0.0 {
             s.cs_cos[c] / s.cos
         } else {
             0.0
         };
-        w.f0[c] * (color.a[c] + color.k[c] * cs)
+        color.a[c] + color.k[c] * cs
     })
+}
+
+/// A measured BRDF's fitted lobe is a function of the facet's own frame (the table is looked up
+/// there): per unit of `n·ωi`, `D_n(h)/(4 n·ωo)` with `D_n(h) = N(s_h − s; σ²)/(n·h)⁴`, where the
+/// base lobe of the analytic views is written in the macro frame's slope space,
+/// `N(s_h − s)/(4 h_z⁴ ωo_z)` ([`crate::microfacet::brdf`]). Averaged over the visible slopes,
+/// the facet-frame lobe is `N(s_h − s̄; Σ + σ²I)·E_post[√(1 + |s|²)/(n_s·h)⁴]/(4 E[u⁺])` (the
+/// projected area `u⁺ = (n·ωo)√(1 + |s|²)` cancels the `n·ωo`), the slope-space one
+/// `N(s_h − s̄; Σ + σ²I)·E_post[u⁺]/(4 h_z⁴ ωo_z E[u⁺])` ([`filtered_specular`]), both over the
+/// posterior `N(s*, Σ*)` of the slopes that carry the lobe. This is their ratio, the posterior
+/// expectations on a 3 × 3 Gauss–Hermite rule (exact for quadratics: a single point at s*
+/// underestimates the convex `1/(n·h)⁴` by 15–50% at 45–75°). At grazing views the slope-space
+/// lobe is 2–3× too bright: a facet tilted toward the viewer sees ωo far less obliquely than the
+/// macro frame does. 1 for an untilted footprint (s̄ = 0, Σ = 0).
+pub(super) fn facet_frame_factor(
+    sigma_lobe: f64,
+    mean: DVec2,
+    sigma: &SlopeCov,
+    wo: DVec3,
+    wi: DVec3,
+) -> f64 {
+    if !(wo.z > 0.0 && wi.z > 0.0) {
+        return 1.0;
+    }
+    let h = (wo + wi).normalize();
+    if !(h.z > 1e-9) {
+        return 1.0;
+    }
+    let sm = sigma.to_mat();
+    let total = (*sigma + SlopeCov::isotropic(sigma_lobe.max(0.0))).to_mat();
+    let det = total.determinant();
+    let (post, cov) = if det > 1e-30 && det.is_finite() {
+        let k = sm * total.inverse();
+        (mean + k * (slope_of(h) - mean), sm - k * sm)
+    } else {
+        (mean, glam::DMat2::ZERO)
+    };
+    // Cholesky of the posterior covariance (clamped to stay real).
+    let a = cov.x_axis.x.max(0.0).sqrt();
+    let b = if a > 0.0 { cov.x_axis.y / a } else { 0.0 };
+    let c = (cov.y_axis.y - b * b).max(0.0).sqrt();
+    const NODES: [(f64, f64); 3] = [
+        (-1.732_050_807_568_877_2, 1.0 / 6.0),
+        (0.0, 2.0 / 3.0),
+        (1.732_050_807_568_877_2, 1.0 / 6.0),
+    ];
+    let (mut facet, mut slope_space) = (0.0, 0.0);
+    for (x, wx) in NODES {
+        for (y, wy) in NODES {
+            let s = post + DVec2::new(a * x, b * x + c * y);
+            let n = normal_of(s);
+            let (no, nh) = (n.dot(wo), n.dot(h));
+            let w = wx * wy;
+            let root = (1.0 + s.length_squared()).sqrt();
+            if no > 0.0 {
+                slope_space += w * no * root;
+                if nh > 1e-6 {
+                    facet += w * root / nh.powi(4);
+                }
+            }
+        }
+    }
+    let r = facet * h.z.powi(4) * wo.z / slope_space;
+    if r.is_finite() && slope_space > 0.0 {
+        r
+    } else {
+        1.0
+    }
 }

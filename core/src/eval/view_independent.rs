@@ -4,7 +4,6 @@
 
 use crate::eval::query::lit;
 use crate::eval::{Evaluator, FootprintQuery};
-use crate::microfacet::slopes::SlopeCov;
 use crate::microfacet::slopes::normal_of;
 use crate::microfacet::visible_slopes::slope_mean;
 use glam::DMat3;
@@ -41,10 +40,7 @@ impl Evaluator {
             sh.cs_cos = cs.map(|v| v * sh.cos);
             sh.cs_env = [0, 1, 2].map(|k| cs[k] * sh.env[k]);
         }
-        let spec = self
-            .material
-            .brdf
-            .specular_with(n, cfg.wo, cfg.wi, SlopeCov::default());
+        let spec = self.facet_specular(n, cfg.wo, cfg.wi);
         let v = sun_visible * lit(cfg, n);
         self.radiance(aff, aff, &sh, v, spec)
     }

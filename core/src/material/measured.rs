@@ -57,41 +57,35 @@ impl MeasuredBrdf {
         self.table.eval(local(wi), local(wo))
     }
 
-    /// The analytic base BRDF the filtered views use: albedo 1 and F0 1 (the fit's per-channel kd
-    /// and F0 are applied as weights, [`MeasuredBrdf::channel_weights`]; F0 0 when the fit has
-    /// no lobe), the fit's σ as base roughness. The measured file stays named.
+    /// The analytic base BRDF the filtered views start from: albedo 1 (the fit's per-channel kd
+    /// is applied as a weight, [`MeasuredBrdf::channel_weights`]), F0 1 when the fit has a lobe
+    /// (its lobes replace the base lobe, [`crate::eval::Evaluator`]'s `specular_lobes`), and the
+    /// narrowest lobe's σ as base roughness. The measured file stays named.
     pub fn fitted_base(&self, measured: Option<String>) -> BaseBrdf {
         BaseBrdf {
             albedo: 1.0,
-            specular: if self.fit.f0.iter().any(|f| *f > 0.0) {
-                1.0
-            } else {
-                0.0
-            },
-            roughness: self.fit.sigma,
+            specular: if self.fit.lobes.is_empty() { 0.0 } else { 1.0 },
+            roughness: self.fit.lobes.first().map_or(0.2, |l| l.sigma),
             measured,
         }
     }
 
-    /// Per-channel weights of the diffuse albedo and of the specular lobe under
-    /// [`MeasuredBrdf::fitted_base`]: the fit's kd and F0.
+    /// Per-channel weights of the diffuse albedo under [`MeasuredBrdf::fitted_base`] (the fit's
+    /// kd), with the specular lobes tinted by the facets' colour.
     pub fn channel_weights(&self) -> ChannelWeights {
         ChannelWeights {
             kd: self.fit.kd,
-            f0: self.fit.f0,
             tint_specular: true,
         }
     }
 }
 
-/// How the base BRDF's scalar albedo and F0 become colours: per-channel weights, and whether the
-/// specular lobe takes the facets' colour (a measured BRDF) or stays white (the analytic one).
+/// How the base BRDF's scalar albedo becomes a colour, and whether the specular lobe takes the
+/// facets' colour (a measured BRDF) or stays white (the analytic one).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ChannelWeights {
     /// Weight of the diffuse albedo per channel.
     pub kd: [f64; 3],
-    /// Weight of the specular lobe per channel.
-    pub f0: [f64; 3],
     /// Whether the specular lobe is tinted by the facets' colour.
     pub tint_specular: bool,
 }
@@ -100,7 +94,6 @@ impl ChannelWeights {
     /// The analytic base BRDF: grey weights, white specular.
     pub const ANALYTIC: ChannelWeights = ChannelWeights {
         kd: [1.0; 3],
-        f0: [1.0; 3],
         tint_specular: false,
     };
 }
@@ -167,7 +160,7 @@ mod tests {
         let m = measured();
         let b = m.fitted_base(Some("x.binary".into()));
         assert_eq!((b.albedo, b.specular), (1.0, 1.0));
-        assert!((b.roughness - m.fit.sigma).abs() < 1e-15);
+        assert_eq!(b.roughness, m.fit.lobes[0].sigma);
         assert_eq!(b.measured.as_deref(), Some("x.binary"));
         let w = m.channel_weights();
         assert!(w.tint_specular);
@@ -176,13 +169,21 @@ mod tests {
             (w.kd[0] - 0.6).abs() < 0.02 && (w.kd[1] - 0.2).abs() < 0.01,
             "{w:?}"
         );
-        assert!(w.f0[0] < 0.01 && w.f0[2] > 0.3, "{w:?}");
+        let lobe = |c: usize| {
+            m.fit
+                .lobes
+                .iter()
+                .map(|l| l.weight[c] + l.fresnel[c])
+                .sum::<f64>()
+        };
+        assert!(lobe(0) < 0.01 && lobe(2) > 0.3, "{:?}", m.fit);
     }
 
     /// A MERL table of an analytic base BRDF, read as the measured base BRDF, renders like that
     /// BRDF in every view: exactly for a Lambertian one (any colour, with the environment), and
     /// within the table's resolution and the frames' difference for a lobe (the analytic lobe is
-    /// written in the macro frame's slope space, the table is looked up in each facet's frame).
+    /// written in the macro frame's slope space, the table is looked up in each facet's frame);
+    /// its filtered view follows its own truth.
     #[test]
     fn a_table_of_the_base_brdf_renders_like_it() {
         use crate::eval::Evaluator;
@@ -233,7 +234,8 @@ mod tests {
             }
         }
 
-        // Diffuse plus the base lobe (σ0 = 0.3), white, on slopes of σ_n = 0.08.
+        // Diffuse plus the base lobe (σ0 = 0.32, a rung of the fit's ladder), white, on slopes of
+        // σ_n = 0.08.
         let mut m = gaussian_material();
         m.color = ColorModel::Attribute {
             mean: [1.0; 3],
@@ -244,7 +246,7 @@ mod tests {
         m.brdf = BaseBrdf {
             albedo: 0.5,
             specular: 0.3,
-            roughness: 0.3,
+            roughness: 0.32,
             measured: Some("lobe.binary".into()),
         };
         let base = m.brdf.clone();
@@ -265,8 +267,16 @@ mod tests {
                 tb.mean, ta.mean
             );
             for c in 0..3 {
+                // The measured lobe is looked up in the facet's frame (truth) and corrected to it
+                // in the filtered view (`facet_frame_factor`); the analytic lobe lives in the
+                // macro frame's slope space. Measured: 0.1–1.9% from the measured truth.
                 assert!(
-                    rel(b[c], a[c]) < 0.015,
+                    rel(b[c], tb.mean[c]) < 0.025,
+                    "{wo} {wi}: filtered {b:?} for the truth {:?}",
+                    tb.mean
+                );
+                assert!(
+                    rel(b[c], a[c]) < 0.03,
                     "{wo} {wi}: filtered {b:?} for {a:?}"
                 );
                 assert!(

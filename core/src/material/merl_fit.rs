@@ -1,41 +1,61 @@
-//! A measured BRDF seen through the base model: the Lambertian-plus-Beckmann BRDF
-//! ([`crate::microfacet::brdf`]) closest to a MERL table ([`MerlBrdf`]), for the analytic views,
-//! which average the base BRDF over a footprint's slopes in closed form and cannot do that with a
-//! table (#18 §2).
+//! A measured BRDF seen through the base model: a Lambertian term plus a few slope-space Beckmann
+//! lobes ([`crate::microfacet::brdf`]), each with a Schlick-like Fresnel term, closest to a MERL
+//! table ([`MerlBrdf`]). For the filtered views, which average the base BRDF over a footprint's
+//! slopes in closed form (a Gaussian lobe convolved with the footprint's Gaussian slopes only adds
+//! variances [HN12 Sec. 5.5]) and cannot do that with a table (#18 §2).
 //!
-//! The model, per channel c, is `ρ_c = kd_c/π + F0_c · D(h)/(4 ωi_z ωo_z)`, D the Beckmann
-//! distribution of slope standard deviation σ shared by the channels (`D = N(s_h; 0, σ²I)/h_z⁴`,
-//! the base lobe's form). It is fitted to `ρ·cos θi` (reflected radiance under unit irradiance, what
-//! an image shows) on a fixed grid of direction pairs: for a given σ the model is linear in
-//! (kd_c, F0_c), solved by least squares per channel with both kept ≥ 0; σ is found by a
-//! golden-section search on log σ over [`SIGMA_RANGE`].
+//! # The model
+//! Per channel c,
 //!
-//! The fit is exact for a table of the model itself (tested: σ, kd and F0 recovered); for other
-//! lobes (GGX tails, Fresnel, retro-reflection) [`MerlFit::relative_error`] says how far it is.
+//! `ρ_c(ωi, ωo) = kd_c/π + Σ_k L_k(ωi, ωo)·(w_kc + v_kc·(1 − ωi·h)⁵)`,
+//!
+//! `L_k = N(s_h; 0, σ_k² I) / (4 h_z⁴ ωi_z ωo_z)` the base lobe of slope deviation σ_k from the
+//! fixed ladder [`LOBE_SIGMAS`] (a GGX or other long-tailed slope density is a scale mixture of
+//! Gaussians, which a few rungs approximate), and `(1 − ωi·h)⁵` Schlick's Fresnel factor (a lobe
+//! `F0 + (1 − F0)(1 − ωi·h)⁵` is `w = F0`, `v = 1 − F0`). Every coefficient is ≥ 0.
+//!
+//! # The fit
+//! The model is linear in its coefficients: per channel, non-negative least squares (projected
+//! coordinate descent on the normal equations) of `ρ·cos θi` on a fixed grid of direction pairs,
+//! each residual relative to `ρ·cos θi + mean` so that the dim directions (off-specular, grazing),
+//! which a plain least squares gives up for the peak, count as much as the peak.
+//!
+//! The fit is exact for a table of the model itself on the ladder (tested); for what the model
+//! lacks (a masking term falling toward grazing, retro-reflection, anisotropy)
+//! [`MerlFit::relative_error`] says how far it is.
 
 use crate::material::merl::MerlBrdf;
 use glam::DVec3;
 use std::f64::consts::{FRAC_1_PI, PI, TAU};
 
-/// Slope standard deviations the fit searches.
-pub const SIGMA_RANGE: (f64, f64) = (0.005, 1.5);
+/// The lobes' slope deviations: a ladder of ratio about 1.6.
+pub const LOBE_SIGMAS: [f64; 10] = [0.02, 0.032, 0.05, 0.08, 0.125, 0.2, 0.32, 0.5, 0.8, 1.25];
 
-/// The base model's parameters closest to a measured BRDF.
+/// One lobe of the fit.
 #[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lobe {
+    /// Slope standard deviation σ_k (Beckmann α = √2 σ_k).
+    pub sigma: f64,
+    /// Weight per channel, w_kc.
+    pub weight: [f64; 3],
+    /// Weight of the Fresnel factor `(1 − ωi·h)⁵` per channel, v_kc.
+    pub fresnel: [f64; 3],
+}
+
+/// The base model closest to a measured BRDF.
+#[derive(Clone, Debug, PartialEq)]
 pub struct MerlFit {
     /// Diffuse albedo per channel (ρ_d = kd/π).
     pub kd: [f64; 3],
-    /// Specular weight per channel (F0 of the base lobe).
-    pub f0: [f64; 3],
-    /// The lobe's slope standard deviation σ (Beckmann α = √2 σ).
-    pub sigma: f64,
+    /// The lobes with a positive coefficient, narrowest first.
+    pub lobes: Vec<Lobe>,
     /// RMS of the residual of `ρ·cos θi` over the fit's samples, relative to the RMS of the
     /// measured `ρ·cos θi`, per channel.
     pub relative_error: [f64; 3],
 }
 
 /// The base lobe `D(h)/(4 ωi_z ωo_z)` of slope deviation σ (0 below the horizon).
-fn lobe(wi: DVec3, wo: DVec3, sigma: f64) -> f64 {
+pub fn lobe(wi: DVec3, wo: DVec3, sigma: f64) -> f64 {
     if wi.z <= 0.0 || wo.z <= 0.0 {
         return 0.0;
     }
@@ -49,7 +69,17 @@ fn lobe(wi: DVec3, wo: DVec3, sigma: f64) -> f64 {
     p22 / h.z.powi(4) / (4.0 * wi.z * wo.z)
 }
 
-/// One fit sample: the pair's cosine and the measured ρ.
+/// Schlick's Fresnel factor `(1 − ωi·h)⁵` of the pair (0 for ωi = −ωo).
+pub fn fresnel_factor(wi: DVec3, wo: DVec3) -> f64 {
+    let s = wi + wo;
+    let len = s.length();
+    if !(len > 1e-12) {
+        return 0.0;
+    }
+    (1.0 - (wi.dot(s) / len).clamp(0.0, 1.0)).powi(5)
+}
+
+/// One fit sample: the pair and the measured ρ.
 struct Sample {
     wi: DVec3,
     wo: DVec3,
@@ -79,103 +109,98 @@ fn samples(m: &MerlBrdf) -> Vec<Sample> {
     out
 }
 
-/// For lobe width σ: per channel the least-squares (kd, F0) ≥ 0 of `ρ cos` and its residual sum
-/// of squares.
-fn solve(samples: &[Sample], sigma: f64) -> ([f64; 3], [f64; 3], [f64; 3]) {
-    // Normal equations of y ≈ kd·a + F0·b with a = cos/π, b = lobe·cos.
-    let (mut aa, mut ab, mut bb) = (0.0, 0.0, 0.0);
-    let (mut ay, mut by, mut yy) = ([0.0; 3], [0.0; 3], [0.0; 3]);
-    for s in samples {
-        let cos = s.wi.z;
-        let a = cos * FRAC_1_PI;
-        let b = lobe(s.wi, s.wo, sigma) * cos;
-        aa += a * a;
-        ab += a * b;
-        bb += b * b;
-        for c in 0..3 {
-            let y = s.rho[c] * cos;
-            ay[c] += a * y;
-            by[c] += b * y;
-            yy[c] += y * y;
+/// Number of basis functions: the Lambertian term, then each lobe and its Fresnel factor.
+const BASES: usize = 1 + 2 * LOBE_SIGMAS.len();
+
+/// The basis functions times cos θi at a pair.
+fn bases(wi: DVec3, wo: DVec3) -> [f64; BASES] {
+    let mut b = [0.0; BASES];
+    let cos = wi.z;
+    b[0] = cos * FRAC_1_PI;
+    let f = fresnel_factor(wi, wo);
+    for (k, s) in LOBE_SIGMAS.iter().enumerate() {
+        let l = lobe(wi, wo, *s) * cos;
+        b[1 + 2 * k] = l;
+        b[2 + 2 * k] = l * f;
+    }
+    b
+}
+
+/// Non-negative least squares on the normal equations `A x = y` (A symmetric positive
+/// semi-definite): projected coordinate descent from 0.
+fn nnls(a: &[[f64; BASES]; BASES], y: &[f64; BASES]) -> [f64; BASES] {
+    let mut x = [0.0; BASES];
+    for _ in 0..4000 {
+        let mut moved = 0.0f64;
+        for j in 0..BASES {
+            if !(a[j][j] > 0.0) {
+                continue;
+            }
+            let g: f64 = (0..BASES).map(|i| a[j][i] * x[i]).sum::<f64>() - y[j];
+            let new = (x[j] - g / a[j][j]).max(0.0);
+            moved = moved.max((new - x[j]).abs() * a[j][j].sqrt());
+            x[j] = if new.is_finite() { new } else { 0.0 };
+        }
+        if moved < 1e-13 {
+            break;
         }
     }
-    let (mut kd, mut f0, mut rss) = ([0.0; 3], [0.0; 3], [0.0; 3]);
-    for c in 0..3 {
-        let det = aa * bb - ab * ab;
-        let (mut k, mut f) = if det > 1e-300 {
-            (
-                (ay[c] * bb - by[c] * ab) / det,
-                (by[c] * aa - ay[c] * ab) / det,
-            )
-        } else {
-            (0.0, 0.0)
-        };
-        // Keep both non-negative: on a negative one, the best fit with it at 0.
-        if k < 0.0 || f < 0.0 || !(k.is_finite() && f.is_finite()) {
-            let only_k = if aa > 0.0 { (ay[c] / aa).max(0.0) } else { 0.0 };
-            let only_f = if bb > 0.0 { (by[c] / bb).max(0.0) } else { 0.0 };
-            let r_k = yy[c] - 2.0 * only_k * ay[c] + only_k * only_k * aa;
-            let r_f = yy[c] - 2.0 * only_f * by[c] + only_f * only_f * bb;
-            (k, f) = if r_k <= r_f {
-                (only_k, 0.0)
-            } else {
-                (0.0, only_f)
-            };
-        }
-        kd[c] = k;
-        f0[c] = f;
-        rss[c] =
-            (yy[c] - 2.0 * (k * ay[c] + f * by[c]) + k * k * aa + 2.0 * k * f * ab + f * f * bb)
-                .max(0.0);
-    }
-    (kd, f0, rss)
+    x
 }
 
 impl MerlFit {
-    /// The base model closest to `m` (see the module docs).
+    /// The model closest to `m` (see the module docs).
     pub fn of(m: &MerlBrdf) -> Self {
         let samples = samples(m);
-        let total = |sigma: f64| solve(&samples, sigma).2.iter().sum::<f64>();
-        // Golden-section search on ln σ, after a coarse scan that picks the bracket (the
-        // residual is not unimodal over the whole range for a table with two lobes).
-        let (lo, hi) = (SIGMA_RANGE.0.ln(), SIGMA_RANGE.1.ln());
-        let n = 24;
-        let grid: Vec<f64> = (0..=n)
-            .map(|i| lo + (hi - lo) * i as f64 / n as f64)
-            .collect();
-        let best = (0..=n)
-            .min_by(|&i, &j| total(grid[i].exp()).total_cmp(&total(grid[j].exp())))
-            .unwrap_or(0);
-        let (mut a, mut b) = (grid[best.saturating_sub(1)], grid[(best + 1).min(n)]);
-        let g = (5f64.sqrt() - 1.0) / 2.0;
-        let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
-        let (mut fc, mut fd) = (total(c.exp()), total(d.exp()));
-        for _ in 0..40 {
-            if fc < fd {
-                b = d;
-                d = c;
-                fd = fc;
-                c = b - g * (b - a);
-                fc = total(c.exp());
-            } else {
-                a = c;
-                c = d;
-                fc = fd;
-                d = a + g * (b - a);
-                fd = total(d.exp());
-            }
-        }
-        let sigma = (0.5 * (a + b)).exp();
-        let (kd, f0, rss) = solve(&samples, sigma);
+        let basis: Vec<[f64; BASES]> = samples.iter().map(|s| bases(s.wi, s.wo)).collect();
+        let mut coef = [[0.0; BASES]; 3];
         let mut relative_error = [0.0; 3];
-        for (c, e) in relative_error.iter_mut().enumerate() {
-            let yy: f64 = samples.iter().map(|s| (s.rho[c] * s.wi.z).powi(2)).sum();
-            *e = if yy > 0.0 { (rss[c] / yy).sqrt() } else { 0.0 };
+        for c in 0..3 {
+            let ys: Vec<f64> = samples.iter().map(|s| s.rho[c] * s.wi.z).collect();
+            let n = ys.len().max(1) as f64;
+            let mean = ys.iter().sum::<f64>() / n;
+            if !(mean > 0.0) {
+                continue;
+            }
+            let mut a = [[0.0; BASES]; BASES];
+            let mut y = [0.0; BASES];
+            for (b, v) in basis.iter().zip(&ys) {
+                // Relative residuals: weight 1/(ρ cos + mean)².
+                let w = (v + mean).powi(-2);
+                for i in 0..BASES {
+                    y[i] += w * b[i] * v;
+                    for j in i..BASES {
+                        a[i][j] += w * b[i] * b[j];
+                    }
+                }
+            }
+            for i in 0..BASES {
+                for j in 0..i {
+                    a[i][j] = a[j][i];
+                }
+            }
+            coef[c] = nnls(&a, &y);
+            let (mut rss, mut yy) = (0.0, 0.0);
+            for (b, v) in basis.iter().zip(&ys) {
+                let fit: f64 = (0..BASES).map(|i| b[i] * coef[c][i]).sum();
+                rss += (fit - v).powi(2);
+                yy += v * v;
+            }
+            relative_error[c] = if yy > 0.0 { (rss / yy).sqrt() } else { 0.0 };
         }
+        let lobes = LOBE_SIGMAS
+            .iter()
+            .enumerate()
+            .map(|(k, s)| Lobe {
+                sigma: *s,
+                weight: [0, 1, 2].map(|c| coef[c][1 + 2 * k]),
+                fresnel: [0, 1, 2].map(|c| coef[c][2 + 2 * k]),
+            })
+            .filter(|l| l.weight.iter().chain(&l.fresnel).any(|v| *v > 0.0))
+            .collect();
         Self {
-            kd,
-            f0,
-            sigma,
+            kd: [0, 1, 2].map(|c| coef[c][0]),
+            lobes,
             relative_error,
         }
     }
@@ -185,8 +210,15 @@ impl MerlFit {
         if wi.z <= 0.0 || wo.z <= 0.0 {
             return [0.0; 3];
         }
-        let l = lobe(wi, wo, self.sigma);
-        [0, 1, 2].map(|c| self.kd[c] / PI + self.f0[c] * l)
+        let f = fresnel_factor(wi, wo);
+        let mut out = self.kd.map(|k| k / PI);
+        for l in &self.lobes {
+            let v = lobe(wi, wo, l.sigma);
+            for c in 0..3 {
+                out[c] += v * (l.weight[c] + l.fresnel[c] * f);
+            }
+        }
+        out
     }
 }
 
@@ -195,58 +227,69 @@ mod tests {
     use super::*;
     use crate::material::merl::directional_albedo;
 
-    #[test]
-    fn a_table_of_the_base_model_gives_its_parameters_back() {
-        let (kd, f0, sigma) = ([0.5, 0.3, 0.1], [0.04, 0.08, 0.4], 0.2);
-        let m = MerlBrdf::tabulate(|wi, wo| {
-            let l = lobe(wi, wo, sigma);
-            [0, 1, 2].map(|c| kd[c] / PI + f0[c] * l)
-        });
-        let fit = MerlFit::of(&m);
-        // Measured: σ within 0.05%, F0 within 0.4%, kd within 1.4% (blue, where the table's
-        // nearest-bin steps of the strong lobe leave a 3.8% residual the diffuse term absorbs).
-        assert!((fit.sigma - sigma).abs() < 0.01 * sigma, "{fit:?}");
-        for c in 0..3 {
-            assert!((fit.kd[c] - kd[c]).abs() < 0.02 * kd[c], "{fit:?}");
-            assert!((fit.f0[c] - f0[c]).abs() < 0.03 * f0[c], "{fit:?}");
-            assert!(fit.relative_error[c] < 0.05, "{fit:?}");
-        }
-    }
-
-    #[test]
-    fn another_lobe_is_fitted_with_a_stated_error() {
-        // A GGX lobe (α = 0.25, long tails) on a grey diffuse base: no Beckmann lobe matches it.
-        // The fit stays finite, moves the tails into the diffuse term (kd 0.28 for 0.2), keeps
-        // the directional albedo (within 1.3% at 0° and 57°), and says how far off it is (12% RMS
-        // of ρ·cos).
-        let ggx = |wi: DVec3, wo: DVec3| {
+    /// A GGX BRDF with Smith masking and Schlick's Fresnel (what the model lacks: the masking).
+    fn ggx(kd: f64, f0: f64, alpha: f64) -> impl Fn(DVec3, DVec3) -> [f64; 3] {
+        move |wi, wo| {
             if wi.z <= 0.0 || wo.z <= 0.0 {
                 return [0.0; 3];
             }
             let h = (wi + wo).normalize();
-            let a2: f64 = 0.25 * 0.25;
+            let a2 = alpha * alpha;
             let d = a2 / (PI * (h.z * h.z * (a2 - 1.0) + 1.0).powi(2));
-            [0.2 / PI + 0.3 * d / (4.0 * wi.z * wo.z); 3]
-        };
-        let table = MerlBrdf::tabulate(ggx);
-        let fit = MerlFit::of(&table);
+            let g1 = |w: DVec3| 2.0 * w.z / (w.z + (a2 + (1.0 - a2) * w.z * w.z).sqrt());
+            let f = f0 + (1.0 - f0) * fresnel_factor(wi, wo);
+            [kd / PI + f * d * g1(wi) * g1(wo) / (4.0 * wi.z * wo.z); 3]
+        }
+    }
+
+    #[test]
+    fn a_table_of_the_model_gives_its_parameters_back() {
+        // Two rungs of the ladder, with Fresnel on one.
+        let (kd, f0) = ([0.5, 0.3, 0.1], [0.04, 0.08, 0.4]);
+        let m = MerlBrdf::tabulate(|wi, wo| {
+            let (a, b) = (lobe(wi, wo, 0.2), lobe(wi, wo, 0.05));
+            let f = fresnel_factor(wi, wo);
+            [0, 1, 2].map(|c| kd[c] / PI + f0[c] * a + 0.02 * (1.0 + f) * b)
+        });
+        let fit = MerlFit::of(&m);
+        eprintln!("{fit:?}");
+        for c in 0..3 {
+            assert!((fit.kd[c] - kd[c]).abs() < 0.02 * kd[c], "{fit:?}");
+            assert!(fit.relative_error[c] < 0.05, "{fit:?}");
+        }
+        // The weight sits on the rungs it was made of.
+        let on = |s: f64| fit.lobes.iter().find(|l| l.sigma == s).copied();
+        let wide = on(0.2).expect("the σ 0.2 lobe");
+        for c in 0..3 {
+            assert!((wide.weight[c] - f0[c]).abs() < 0.1 * f0[c], "{fit:?}");
+        }
+        let narrow = on(0.05).expect("the σ 0.05 lobe");
         assert!(
-            fit.sigma.is_finite() && fit.sigma > 0.05 && fit.sigma < 0.5,
+            (narrow.weight[0] + narrow.fresnel[0] - 0.04).abs() < 0.01,
             "{fit:?}"
         );
-        assert!(
-            fit.relative_error[0] > 0.01 && fit.relative_error[0] < 0.5,
-            "{fit:?}"
-        );
-        for theta_o in [0.0f64, 1.0] {
-            let wo = DVec3::new(theta_o.sin(), 0.0, theta_o.cos());
-            let fitted = directional_albedo(wo, 100, |wi, wo| fit.eval(wi, wo))[0];
-            let measured = table.albedo(wo, 100)[0];
-            eprintln!("θo {theta_o}: fitted albedo {fitted}, table {measured}");
-            assert!(
-                (fitted - measured).abs() < 0.03 * measured,
-                "θo {theta_o}: fitted albedo {fitted}, table {measured}"
-            );
+    }
+
+    /// A GGX lobe (long tails) with Schlick's Fresnel and Smith masking: the ladder follows its
+    /// tails and its Fresnel, keeps the directional albedo within 3% at 0° and 57°, and states its
+    /// error (the masking it lacks). One Beckmann lobe left 12–50% here.
+    #[test]
+    fn a_ggx_lobe_is_fitted_with_a_stated_error() {
+        for (kd, f0, alpha) in [(0.2, 0.04, 0.25), (0.0, 0.9, 0.15)] {
+            let table = MerlBrdf::tabulate(ggx(kd, f0, alpha));
+            let fit = MerlFit::of(&table);
+            eprintln!("GGX kd {kd} F0 {f0} α {alpha}: {:?}", fit.relative_error);
+            assert!(fit.relative_error[0] < 0.15, "{fit:?}");
+            for theta_o in [0.0f64, 1.0] {
+                let wo = DVec3::new(theta_o.sin(), 0.0, theta_o.cos());
+                let fitted = directional_albedo(wo, 100, |wi, wo| fit.eval(wi, wo))[0];
+                let measured = table.albedo(wo, 100)[0];
+                eprintln!("θo {theta_o}: fitted albedo {fitted}, table {measured}");
+                assert!(
+                    (fitted - measured).abs() < 0.03 * measured,
+                    "θo {theta_o}: fitted albedo {fitted}, table {measured}"
+                );
+            }
         }
     }
 
@@ -254,9 +297,8 @@ mod tests {
     fn a_black_table_fits_to_black() {
         let fit = MerlFit::of(&MerlBrdf::tabulate(|_, _| [0.0; 3]));
         assert_eq!(
-            (fit.kd, fit.f0, fit.relative_error),
-            ([0.0; 3], [0.0; 3], [0.0; 3])
+            (fit.kd, fit.lobes.len(), fit.relative_error),
+            ([0.0; 3], 0, [0.0; 3])
         );
-        assert!(fit.sigma.is_finite());
     }
 }

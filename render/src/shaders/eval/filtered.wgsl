@@ -43,9 +43,9 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
     let s_mean = loc.stats.slope_mean;
     let shading = visible_shading(s_mean, cov, wo_w, wi_w);
     let lit = sun_visible * vbar;
-    var spec = filtered_specular(s_mean, cov, wo_w, wi_w);
+    var spec = specular_lobes(s_mean, cov, wo_w, wi_w);
     // The density ratio scales only the sun's specular term: skipped where it changes nothing.
-    if (spec > 0.0 && lit > 0.0 && params.sun != 0.0) {
+    if (any(spec > vec3<f32>(0.0)) && lit > 0.0 && params.sun != 0.0) {
         spec = spec * lobe_density_ratio(fp, s_mean, wo_w, wi_w);
     }
     return radiance(sun_color, env_color, shading, lit, spec);
@@ -57,7 +57,7 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
     }
     let d = input_distribution(loc);
     let aff = affine(color_of_distribution(d.x, d.y, 0.0, vec2<f32>(0.0, 1.0), d.y * d.y));
-    let spec = filtered_specular(vec2<f32>(0.0), vec3<f32>(0.0), wo_w, wi_w);
+    let spec = specular_lobes(vec2<f32>(0.0), vec3<f32>(0.0), wo_w, wi_w);
     return radiance(aff, aff, point_shading(vec3<f32>(0.0, 0.0, 1.0), wi_w), sun_visible * select(0.0, 1.0, wi_w.z > 0.0), spec);
 //#endif
 }
@@ -67,7 +67,7 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
 fn lobe_density_ratio(fp: vec3<f32>, s_mean: vec2<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
 //#if noise
 //#if specular
-    if (params.driver_kind != DRIVER_IMAGE && params.specular > 0.0 && params.noise_slopes != 0u
+    if (params.driver_kind != DRIVER_IMAGE && params.specular > 0.0 && params.noise_slopes != 0u && params.measured == 0u
         && params.transfer_kind == TRANSFER_IDENTITY && wo.z > 0.0 && wi.z > 0.0) {
         let h = normalize(wo + wi);
         if (h.z > 1e-9) {

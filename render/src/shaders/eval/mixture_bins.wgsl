@@ -102,9 +102,9 @@ fn filtered_bins(loc: FootprintStats, wo_w: vec3<f32>, wi_w: vec3<f32>, wo: vec3
         let sums = visible_shading_sums(s_mean, cov, wo_w, wi_w, params.mix_rule_offset, params.mix_points);
         den = den + w1 * sums.den;
         var v = 0.0;
-        var spec = 0.0;
+        var spec = vec3<f32>(0.0);
         if (sun_lit) {
-            spec = filtered_specular(s_mean, cov, wo_w, wi_w) * sums.den;
+            spec = specular_lobes(s_mean, cov, wo_w, wi_w) * sums.den;
             v = w2 * sun;
         }
         let c = affine(bin.color);

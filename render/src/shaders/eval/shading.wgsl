@@ -60,24 +60,119 @@ fn point_shading(n: vec3<f32>, wi: vec3<f32>) -> SlopeShading {
 }
 
 // Evaluator::radiance (with the channel weights kd_rgb, f0_rgb).
-fn radiance(sun_color: Affine, env_color: Affine, s: SlopeShading, v: f32, spec: f32) -> vec3<f32> {
+fn radiance(sun_color: Affine, env_color: Affine, s: SlopeShading, v: f32, spec: vec3<f32>) -> vec3<f32> {
     let sun = params.sun * v;
     let kd = params.albedo * FRAC_1_PI * params.kd_rgb;
     return kd * (sun * (sun_color.a * s.cos + sun_color.k * s.cs_cos) + env_color.a * s.env + env_color.k * s.cs_env) + sun * spec * specular_tint(sun_color, s);
 }
 
-// shading::specular_tint: the lobe's channel weights, times the lit facets' mean colour for a
-// measured BRDF.
+// shading::specular_tint: 1, or the lit facets' mean colour for a measured BRDF.
 fn specular_tint(color: Affine, s: SlopeShading) -> vec3<f32> {
     if (params.measured == 0u) {
-        return params.f0_rgb;
+        return vec3<f32>(1.0);
     }
     var cs = vec3<f32>(0.0);
     if (s.cos > 0.0) {
         cs = s.cs_cos / s.cos;
     }
-    return params.f0_rgb * (color.a + color.k * cs);
+    return color.a + color.k * cs;
 }
+
+// Evaluator::specular_lobes: the base lobe, or a measured BRDF's fitted lobes, over the visible
+// slopes N(mean, cov) (world slope space).
+fn specular_lobes(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+//#if measured
+    if (params.measured != 0u) {
+        let f = fresnel_factor(wi, wo);
+        var out = vec3<f32>(0.0);
+        for (var k = 0u; k < params.lobe_count; k = k + 1u) {
+            let o = params.lobe_offset + 7u * k;
+            let sigma = data[o];
+            let v = filtered_lobe(1.0, sigma, mean, cov, wo, wi) * facet_frame_factor(sigma, mean, cov, wo, wi);
+            out = out + v * (vec3<f32>(data[o + 1u], data[o + 2u], data[o + 3u]) + vec3<f32>(data[o + 4u], data[o + 5u], data[o + 6u]) * f);
+        }
+        return out;
+    }
+//#endif
+    return vec3<f32>(filtered_specular(mean, cov, wo, wi));
+}
+
+// Evaluator::facet_specular: the base lobe at facet n, or a measured BRDF's fitted lobes in the
+// facet's own frame.
+fn facet_specular(n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
+//#if measured
+    if (params.measured != 0u) {
+        let f = fresnel_factor(wi, wo);
+        let t = basis_t(n);
+        let b = basis_b(n);
+        let wo_l = vec3<f32>(dot(wo, t), dot(wo, b), dot(wo, n));
+        let wi_l = vec3<f32>(dot(wi, t), dot(wi, b), dot(wi, n));
+        var out = vec3<f32>(0.0);
+        for (var k = 0u; k < params.lobe_count; k = k + 1u) {
+            let o = params.lobe_offset + 7u * k;
+            let v = specular_lobe(1.0, data[o], vec3<f32>(0.0, 0.0, 1.0), wo_l, wi_l, vec3<f32>(0.0));
+            out = out + v * (vec3<f32>(data[o + 1u], data[o + 2u], data[o + 3u]) + vec3<f32>(data[o + 4u], data[o + 5u], data[o + 6u]) * f);
+        }
+        return out;
+    }
+//#endif
+    return vec3<f32>(specular_with(n, wo, wi, vec3<f32>(0.0)));
+}
+
+//#if measured
+// shading::facet_frame_factor: the facet-frame lobe over the slope-space one, both averaged over
+// the posterior N(s*, Σ*) of the slopes that carry the lobe on a 3 × 3 Gauss–Hermite rule.
+fn facet_frame_factor(sigma_lobe: f32, mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+    if (!(wo.z > 0.0 && wi.z > 0.0)) {
+        return 1.0;
+    }
+    let h = normalize(wo + wi);
+    if (!(h.z > 1e-9)) {
+        return 1.0;
+    }
+    let s0 = max(sigma_lobe, 0.0);
+    let total = cov + vec3<f32>(s0 * s0, s0 * s0, 0.0);
+    let det = total.x * total.y - total.z * total.z;
+    var post = mean;
+    var post_cov = vec3<f32>(0.0);
+    if (det > 1e-30) {
+        let inv = vec3<f32>(total.y, total.x, -total.z) / det;
+        let k0 = vec2<f32>(cov.x * inv.x + cov.z * inv.z, cov.z * inv.x + cov.y * inv.z);
+        let k1 = vec2<f32>(cov.x * inv.z + cov.z * inv.y, cov.z * inv.z + cov.y * inv.y);
+        let d = slope_of(h) - mean;
+        post = mean + k0 * d.x + k1 * d.y;
+        let c0 = k0 * cov.x + k1 * cov.z;
+        let c1 = k0 * cov.z + k1 * cov.y;
+        post_cov = vec3<f32>(cov.x - c0.x, cov.y - c1.y, cov.z - 0.5 * (c0.y + c1.x));
+    }
+    let l = cholesky(post_cov);
+    let z = array<f32, 3>(-1.7320508, 0.0, 1.7320508);
+    let w = array<f32, 3>(1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0);
+    var facet = 0.0;
+    var slope_space = 0.0;
+    for (var i = 0u; i < 3u; i = i + 1u) {
+        for (var j = 0u; j < 3u; j = j + 1u) {
+            let s = post + vec2<f32>(l.x * z[i], l.y * z[i] + l.z * z[j]);
+            let n = normal_of(s);
+            let no = dot(n, wo);
+            let nh = dot(n, h);
+            let wt = w[i] * w[j];
+            let root = sqrt(1.0 + dot(s, s));
+            if (no > 0.0) {
+                slope_space = slope_space + wt * no * root;
+                if (nh > 1e-6) {
+                    facet = facet + wt * root / pow(nh, 4.0);
+                }
+            }
+        }
+    }
+    let r = facet * pow(h.z, 4.0) * wo.z / slope_space;
+    if (slope_space > 0.0 && r == r && abs(r) < 3.0e38) {
+        return r;
+    }
+    return 1.0;
+}
+//#endif
 
 // Evaluator::facet_radiance (the frame is shading_frame): the base BRDF at facet n, or a measured
 // BRDF's table in the facet's frame tinted by its colour.
@@ -94,8 +189,7 @@ fn facet_radiance(color: Affine, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, v: 
         return sun * (color.a * s.cos + color.k * s.cs_cos) * rho + kd * (color.a * s.env + color.k * s.cs_env);
     }
 //#endif
-    let spec = specular_with(n, wo, wi, vec3<f32>(0.0));
-    return radiance(color, color, s, v, spec);
+    return radiance(color, color, s, v, facet_specular(n, wo, wi));
 }
 
 fn has_environment() -> bool {

@@ -35,6 +35,5 @@ fn eval_view_independent(x0: vec2<f32>, fp: vec3<f32>, wo: vec3<f32>, wi: vec3<f
     sh.cs_cos = cs * sh.cos;
     sh.cs_env = cs * sh.env;
 //#endif
-    let spec = specular_with(n, wo, wi, vec3<f32>(0.0));
-    return radiance(aff, aff, sh, sun_visible * lit(wi, n), spec);
+    return radiance(aff, aff, sh, sun_visible * lit(wi, n), facet_specular(n, wo, wi));
 }

@@ -12,26 +12,37 @@ fn gaussian2(d: vec2<f32>, c: vec3<f32>) -> f32 {
 
 //#endif
 fn specular_with(n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, extra: vec3<f32>) -> f32 {
+    return specular_lobe(params.specular, params.roughness, n, wo, wi, extra);
+}
+
+// BaseBrdf::specular_with for a lobe of weight f0 and deviation `roughness` (the base lobe, or one
+// of a measured BRDF's fitted lobes).
+fn specular_lobe(f0: f32, roughness: f32, n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, extra: vec3<f32>) -> f32 {
 //#if specular
-    if (params.specular <= 0.0 || dot(n, wi) <= 0.0 || dot(n, wo) <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0) {
+    if (f0 <= 0.0 || dot(n, wi) <= 0.0 || dot(n, wo) <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0) {
         return 0.0;
     }
     let h = normalize(wo + wi);
     if (h.z <= 1e-9) {
         return 0.0;
     }
-    let s0 = max(params.roughness, 0.0);
+    let s0 = max(roughness, 0.0);
     let d = gaussian2(slope_of(h) - slope_of(n), extra + vec3<f32>(s0 * s0, s0 * s0, 0.0));
-    return params.specular * d / (4.0 * pow(h.z, 4.0) * wo.z);
+    return f0 * d / (4.0 * pow(h.z, 4.0) * wo.z);
 //#else
     return 0.0;
 //#endif
 }
 
-// brdf::filtered_specular (world slope space, facet slopes N(mean, cov)).
+// brdf::filtered_specular (world slope space, facet slopes N(mean, cov)) of the base lobe.
 fn filtered_specular(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
+    return filtered_lobe(params.specular, params.roughness, mean, cov, wo, wi);
+}
+
+// brdf::filtered_specular of a lobe of weight f0 and deviation `roughness`.
+fn filtered_lobe(f0: f32, roughness: f32, mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
 //#if specular
-    if (params.specular <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0) {
+    if (f0 <= 0.0 || wo.z <= 0.0 || wi.z <= 0.0) {
         return 0.0;
     }
     let h = normalize(wo + wi);
@@ -39,7 +50,7 @@ fn filtered_specular(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f3
         return 0.0;
     }
     let sh = slope_of(h);
-    let s0 = max(params.roughness, 0.0);
+    let s0 = max(roughness, 0.0);
     let total = cov + vec3<f32>(s0 * s0, s0 * s0, 0.0);
     // Posterior of the facet slope given the half vector: s* = s̄ + K(s_h − s̄), Σ* = Σ − KΣ.
     let det = total.x * total.y - total.z * total.z;
@@ -60,7 +71,7 @@ fn filtered_specular(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f3
     let u_post = expected_positive_part(wo.z, wo.xy, post_mean, post_cov);
     let eu = expected_positive_part(wo.z, wo.xy, mean, cov);
     let dens = gaussian2(sh - mean, total);
-    return params.specular * dens * (u_post / max(eu, 1e-30)) / (4.0 * pow(h.z, 4.0) * wo.z);
+    return f0 * dens * (u_post / max(eu, 1e-30)) / (4.0 * pow(h.z, 4.0) * wo.z);
 //#else
     return 0.0;
 //#endif
