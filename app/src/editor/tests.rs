@@ -702,3 +702,75 @@ fn dropping_an_environment_map_sets_the_environment() {
         "undone"
     );
 }
+
+/// Dropping a MERL `.binary` onto the window makes it the measured base BRDF (one undo step); it
+/// loads off the UI thread and the inspector shows its fit. A bad file says why, and nothing else
+/// changes.
+#[test]
+fn dropping_a_measured_brdf_loads_it_and_shows_its_fit() {
+    use lodestone_core::material::merl::MerlBrdf;
+    let dir = std::env::temp_dir().join(format!("lodestone-editor-merl-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = dir.join("lambert.binary");
+    std::fs::write(
+        &good,
+        MerlBrdf::tabulate(|_, _| [0.5 / std::f64::consts::PI; 3]).to_bytes(),
+    )
+    .unwrap();
+    let bad = dir.join("short.binary");
+    std::fs::write(&bad, [0u8; 100]).unwrap();
+    #[derive(Debug)]
+    struct Dropped(std::path::PathBuf);
+    impl egui::DroppedFile for Dropped {
+        fn path(&self) -> &std::path::Path {
+            &self.0
+        }
+        fn bytes(&self) -> Result<Vec<u8>, String> {
+            std::fs::read(&self.0).map_err(|e| e.to_string())
+        }
+    }
+    let mut h = harness(1400.0, 900.0, DeviceSource::Unavailable);
+    h.step();
+    h.input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped(good.clone())));
+    let t0 = Instant::now();
+    h.step();
+    assert_eq!(
+        h.state().material().brdf.measured.as_deref(),
+        Some(good.to_str().unwrap())
+    );
+    while h.state().inspector.measured_fit.is_none() {
+        assert!(t0.elapsed() < Duration::from_secs(60), "never loaded");
+        std::thread::sleep(Duration::from_millis(10));
+        h.step();
+    }
+    let fit = h.state().inspector.measured_fit.clone().unwrap();
+    assert!(
+        (fit.kd[0] - 0.5).abs() < 1e-3 && fit.lobes.is_empty(),
+        "{fit:?}"
+    );
+    h.run_steps(2);
+    h.get_by_label_contains("Fit for the filtered views: kd (0.500, 0.500, 0.500)");
+    // A truncated file: the fit goes, the notice names the file and the fault.
+    h.input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped(bad.clone())));
+    let t0 = Instant::now();
+    h.step();
+    while h.state().inspector.measured_fit.is_some()
+        || h.query_by_label_contains("truncated").is_none()
+    {
+        assert!(t0.elapsed() < Duration::from_secs(30), "no error shown");
+        std::thread::sleep(Duration::from_millis(10));
+        h.step();
+    }
+    // Two undo steps back to the analytic BRDF.
+    for _ in 0..2 {
+        h.key_press_modifiers(Modifiers::COMMAND, Key::Z);
+        h.step();
+        h.step();
+    }
+    assert!(h.state().material().brdf.measured.is_none(), "undone");
+    let _ = std::fs::remove_dir_all(&dir);
+}
