@@ -57,7 +57,10 @@ pub struct Row {
 /// The variants of `m` that switch one term off (those that change something).
 pub fn variants(m: &Material) -> Vec<(&'static str, Material)> {
     let mut out = vec![("full", m.clone())];
-    if m.brdf.specular > 0.0 {
+    // A measured BRDF has no diffuse/specular split to switch off (its table replaces albedo and
+    // specular): only its colour and lighting are varied.
+    let measured = m.brdf.measured.is_some();
+    if m.brdf.specular > 0.0 && !measured {
         let mut d = m.clone();
         d.brdf.specular = 0.0;
         out.push(("diffuse only", d.clone()));
@@ -72,7 +75,7 @@ pub fn variants(m: &Material) -> Vec<(&'static str, Material)> {
         correlation: [0.0; 3],
     };
     grey.terms = ColorTerms::default();
-    out.push(("diffuse, grey", grey));
+    out.push((if measured { "grey" } else { "diffuse, grey" }, grey));
     if m.lighting.environment.is_some() && m.lighting.sun > 0.0 {
         let mut sun = m.clone();
         sun.lighting.environment = None;

@@ -401,6 +401,30 @@ fn regenerate_app_screenshots() {
             h.step();
         }
     });
+    shoot("measured-plastic", &|h| {
+        // A red plastic (GGX α 0.15 with Schlick's Fresnel), written in the MERL format, as the
+        // measured base BRDF of the default preset's relief under a white colour map.
+        use lodestone_core::material::merl::{MerlBrdf, ggx_reference};
+        let file = std::env::temp_dir().join("lodestone-shot-red-plastic.binary");
+        let table = MerlBrdf::tabulate(ggx_reference([0.5, 0.06, 0.05], [0.04; 3], 0.15));
+        std::fs::write(&file, table.to_bytes()).expect("write the table");
+        let mut m = h.state().material().clone();
+        m.brdf.measured = Some(file.display().to_string());
+        m.color = lodestone_core::material::ColorModel::Attribute {
+            mean: [1.0; 3],
+            correlation: [0.0; 3],
+        };
+        m.name = "red plastic (measured)".into();
+        h.state_mut().doc.material = m;
+        h.state_mut().view.camera.elevation_deg = 70.0;
+        h.state_mut().view.camera.distance = 3.0;
+        h.step();
+        h.step();
+        for header in ["Driver f", "Heights", "Slopes"] {
+            h.get_by_label(header).click_accesskit();
+            h.step();
+        }
+    });
     shoot("snow-under-sky-grazing", &|h| {
         let ctx = h.ctx.clone();
         h.state_mut().open_path(&ctx, &preset("snow-under-sky.ron"));

@@ -318,6 +318,25 @@ impl MerlBrdf {
     }
 }
 
+/// A reference BRDF unlike the base model, for tests and tools that need a realistic table (write
+/// it with [`MerlBrdf::tabulate`]): Lambert `kd/π` plus a GGX lobe of roughness α with the
+/// uncorrelated Smith masking of GGX and Schlick's Fresnel from `f0`, per steradian. 0 below the
+/// horizon.
+pub fn ggx_reference(kd: [f64; 3], f0: [f64; 3], alpha: f64) -> impl Fn(DVec3, DVec3) -> [f64; 3] {
+    move |wi, wo| {
+        if wi.z <= 0.0 || wo.z <= 0.0 {
+            return [0.0; 3];
+        }
+        let h = (wi + wo).normalize();
+        let a2 = alpha * alpha;
+        let d = a2 / (PI * (h.z * h.z * (a2 - 1.0) + 1.0).powi(2));
+        let g1 = |w: DVec3| 2.0 * w.z / (w.z + (a2 + (1.0 - a2) * w.z * w.z).sqrt());
+        let spec = d * g1(wi) * g1(wo) / (4.0 * wi.z * wo.z);
+        let c = (1.0 - wi.dot(h).clamp(0.0, 1.0)).powi(5);
+        [0, 1, 2].map(|k| kd[k] / PI + (f0[k] + (1.0 - f0[k]) * c) * spec)
+    }
+}
+
 /// Directional albedo of a BRDF `rho(ωi, ωo)` (per steradian, linear RGB) toward ωo,
 /// `∫ ρ(ωi, ωo) cos θi dωi`, by an `n × 4n` midpoint rule in (cos θi, φi): a summary for reports
 /// and tests, for tables and analytic BRDFs alike.

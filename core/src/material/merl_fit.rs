@@ -235,22 +235,7 @@ impl MerlFit {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::merl::directional_albedo;
-
-    /// A GGX BRDF with Smith masking and Schlick's Fresnel (what the model lacks: the masking).
-    fn ggx(kd: f64, f0: f64, alpha: f64) -> impl Fn(DVec3, DVec3) -> [f64; 3] {
-        move |wi, wo| {
-            if wi.z <= 0.0 || wo.z <= 0.0 {
-                return [0.0; 3];
-            }
-            let h = (wi + wo).normalize();
-            let a2 = alpha * alpha;
-            let d = a2 / (PI * (h.z * h.z * (a2 - 1.0) + 1.0).powi(2));
-            let g1 = |w: DVec3| 2.0 * w.z / (w.z + (a2 + (1.0 - a2) * w.z * w.z).sqrt());
-            let f = f0 + (1.0 - f0) * fresnel_factor(wi, wo);
-            [kd / PI + f * d * g1(wi) * g1(wo) / (4.0 * wi.z * wo.z); 3]
-        }
-    }
+    use crate::material::merl::{directional_albedo, ggx_reference};
 
     #[test]
     fn a_table_of_the_model_gives_its_parameters_back() {
@@ -286,7 +271,7 @@ mod tests {
     #[test]
     fn a_ggx_lobe_is_fitted_with_a_stated_error() {
         for (kd, f0, alpha) in [(0.2, 0.04, 0.25), (0.0, 0.9, 0.15)] {
-            let table = MerlBrdf::tabulate(ggx(kd, f0, alpha));
+            let table = MerlBrdf::tabulate(ggx_reference([kd; 3], [f0; 3], alpha));
             let fit = MerlFit::of(&table);
             eprintln!("GGX kd {kd} F0 {f0} α {alpha}: {:?}", fit.relative_error);
             assert!(fit.relative_error[0] < 0.15, "{fit:?}");
