@@ -6,7 +6,7 @@
 //!
 //! `cargo test -p lodestone-tests --release --test measured_accuracy -- --ignored --nocapture`
 //! prints the full grid; the default run checks a few configurations against the bounds measured
-//! there. Measured 2026-12-03, 200 000 rays: plastic filtered −17% to +2% (mean |e| 6.3%), gold
+//! there. Measured 2026-12-03, 200 000 rays: plastic filtered −17% to +2% (mean |e| 6.6%), gold
 //! −49% to +14% (mean 17%), both worst at 75° with the light on the viewer's side, too dark;
 //! naive 20–930% off.
 

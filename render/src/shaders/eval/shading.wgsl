@@ -120,6 +120,9 @@ fn facet_specular(n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
 }
 
 //#if measured
+// shading::FACET_FRAME_MAX.
+const FACET_FRAME_MAX: f32 = 2.0;
+
 // shading::facet_frame_factor: the facet-frame lobe over the slope-space one, both averaged over
 // the posterior N(s*, Σ*) of the slopes that carry the lobe on a 3 × 3 Gauss–Hermite rule.
 fn facet_frame_factor(sigma_lobe: f32, mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
@@ -166,9 +169,10 @@ fn facet_frame_factor(sigma_lobe: f32, mean: vec2<f32>, cov: vec3<f32>, wo: vec3
             }
         }
     }
+    // At most FACET_FRAME_MAX (core's comment: the fit lacks the tables' masking at silhouettes).
     let r = facet * pow(h.z, 4.0) * wo.z / slope_space;
     if (slope_space > 0.0 && r == r && abs(r) < 3.0e38) {
-        return r;
+        return min(r, FACET_FRAME_MAX);
     }
     return 1.0;
 }
