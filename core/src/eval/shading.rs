@@ -6,7 +6,8 @@ use crate::eval::Evaluator;
 use crate::material::color_terms::Affine;
 use crate::material::measured::ChannelWeights;
 use crate::material::merl_fit::fresnel_factor;
-use crate::microfacet::brdf::{BaseBrdf, filtered_specular};
+use crate::math::gaussian::cholesky;
+use crate::microfacet::brdf::{BaseBrdf, filtered_specular, lobe_posterior};
 use crate::microfacet::slopes::SlopeCov;
 use crate::microfacet::slopes::{normal_of, slope_of};
 use crate::microfacet::visible_slopes::visible_slope_nodes;
@@ -278,19 +279,8 @@ pub(super) fn facet_frame_factor(
     if !(h.z > 1e-9) {
         return 1.0;
     }
-    let sm = sigma.to_mat();
-    let total = (*sigma + SlopeCov::isotropic(sigma_lobe.max(0.0))).to_mat();
-    let det = total.determinant();
-    let (post, cov) = if det > 1e-30 && det.is_finite() {
-        let k = sm * total.inverse();
-        (mean + k * (slope_of(h) - mean), sm - k * sm)
-    } else {
-        (mean, glam::DMat2::ZERO)
-    };
-    // Cholesky of the posterior covariance (clamped to stay real).
-    let a = cov.x_axis.x.max(0.0).sqrt();
-    let b = if a > 0.0 { cov.x_axis.y / a } else { 0.0 };
-    let c = (cov.y_axis.y - b * b).max(0.0).sqrt();
+    let (post, cov) = lobe_posterior(mean, sigma, slope_of(h), sigma_lobe);
+    let (a, b, c) = cholesky(cov.xx, cov.xy, cov.yy);
     const NODES: [(f64, f64); 3] = [
         (-1.732_050_807_568_877_2, 1.0 / 6.0),
         (0.0, 2.0 / 3.0),

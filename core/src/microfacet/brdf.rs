@@ -133,26 +133,39 @@ pub fn filtered_specular(
     let b = DVec2::new(wo.x, wo.y);
     let s0 = roughness.max(0.0);
     let total = *sigma + SlopeCov::isotropic(s0);
-    let (sm, cm) = (sigma.to_mat(), total.to_mat());
-    let det = cm.determinant();
-    let (post_mean, post_cov) = if det > 1e-30 && det.is_finite() {
-        let k = sm * cm.inverse();
-        let pc = sm - k * sm;
-        (mean + k * (sh - mean), {
-            let c = SlopeCov::from_mat(pc);
-            SlopeCov {
-                xx: c.xx.max(0.0),
-                yy: c.yy.max(0.0),
-                xy: c.xy,
-            }
-        })
-    } else {
-        (sh, SlopeCov::default())
-    };
+    let (post_mean, post_cov) = lobe_posterior(mean, sigma, sh, roughness);
     let u_post = expected_positive_part(wo.z, b, post_mean, &post_cov);
     let eu = expected_positive_part(wo.z, b, mean, sigma);
     let d = gaussian2(sh - mean, total);
     f0 * d * (u_post / eu.max(1e-300)) / (4.0 * h.z.powi(4) * wo.z)
+}
+
+/// The facet slopes that carry a lobe: facet slopes `N(s̄, Σ)` times the base lobe
+/// `N(s_h − s; σ0²I)` is, up to a constant, `N(s*, Σ*)` with `s* = s̄ + K(s_h − s̄)`,
+/// `Σ* = Σ − KΣ`, `K = Σ(Σ + σ0²I)⁻¹` (its diagonal floored at 0 against round-off). When both
+/// are degenerate (Σ = 0, σ0 = 0) the point s_h.
+pub fn lobe_posterior(
+    mean: DVec2,
+    sigma: &SlopeCov,
+    sh: DVec2,
+    roughness: f64,
+) -> (DVec2, SlopeCov) {
+    let total = *sigma + SlopeCov::isotropic(roughness.max(0.0));
+    let (sm, cm) = (sigma.to_mat(), total.to_mat());
+    let det = cm.determinant();
+    if !(det > 1e-30 && det.is_finite()) {
+        return (sh, SlopeCov::default());
+    }
+    let k = sm * cm.inverse();
+    let c = SlopeCov::from_mat(sm - k * sm);
+    (
+        mean + k * (sh - mean),
+        SlopeCov {
+            xx: c.xx.max(0.0),
+            yy: c.yy.max(0.0),
+            xy: c.xy,
+        },
+    )
 }
 
 #[cfg(test)]

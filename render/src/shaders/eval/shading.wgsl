@@ -133,22 +133,9 @@ fn facet_frame_factor(sigma_lobe: f32, mean: vec2<f32>, cov: vec3<f32>, wo: vec3
     if (!(h.z > 1e-9)) {
         return 1.0;
     }
-    let s0 = max(sigma_lobe, 0.0);
-    let total = cov + vec3<f32>(s0 * s0, s0 * s0, 0.0);
-    let det = total.x * total.y - total.z * total.z;
-    var post = mean;
-    var post_cov = vec3<f32>(0.0);
-    if (det > 1e-30) {
-        let inv = vec3<f32>(total.y, total.x, -total.z) / det;
-        let k0 = vec2<f32>(cov.x * inv.x + cov.z * inv.z, cov.z * inv.x + cov.y * inv.z);
-        let k1 = vec2<f32>(cov.x * inv.z + cov.z * inv.y, cov.z * inv.z + cov.y * inv.y);
-        let d = slope_of(h) - mean;
-        post = mean + k0 * d.x + k1 * d.y;
-        let c0 = k0 * cov.x + k1 * cov.z;
-        let c1 = k0 * cov.z + k1 * cov.y;
-        post_cov = vec3<f32>(cov.x - c0.x, cov.y - c1.y, cov.z - 0.5 * (c0.y + c1.x));
-    }
-    let l = cholesky(post_cov);
+    let p = lobe_posterior(mean, cov, slope_of(h), sigma_lobe);
+    let post = p.mean;
+    let l = cholesky(p.cov);
     let z = array<f32, 3>(-1.7320508, 0.0, 1.7320508);
     let w = array<f32, 3>(1.0 / 6.0, 2.0 / 3.0, 1.0 / 6.0);
     var facet = 0.0;

@@ -52,23 +52,8 @@ fn filtered_lobe(f0: f32, roughness: f32, mean: vec2<f32>, cov: vec3<f32>, wo: v
     let sh = slope_of(h);
     let s0 = max(roughness, 0.0);
     let total = cov + vec3<f32>(s0 * s0, s0 * s0, 0.0);
-    // Posterior of the facet slope given the half vector: s* = s̄ + K(s_h − s̄), Σ* = Σ − KΣ.
-    let det = total.x * total.y - total.z * total.z;
-    var post_mean = sh;
-    var post_cov = vec3<f32>(0.0);
-    if (det > 1e-30) {
-        let inv = vec3<f32>(total.y, total.x, -total.z) / det;
-        // K = Σ·C⁻¹ (general 2×2: columns k0, k1).
-        let k0 = vec2<f32>(cov.x * inv.x + cov.z * inv.z, cov.z * inv.x + cov.y * inv.z);
-        let k1 = vec2<f32>(cov.x * inv.z + cov.z * inv.y, cov.z * inv.z + cov.y * inv.y);
-        let d = sh - mean;
-        post_mean = mean + k0 * d.x + k1 * d.y;
-        // KΣ: columns K·(xx, xy) and K·(xy, yy).
-        let c0 = k0 * cov.x + k1 * cov.z;
-        let c1 = k0 * cov.z + k1 * cov.y;
-        post_cov = vec3<f32>(max(cov.x - c0.x, 0.0), max(cov.y - c1.y, 0.0), cov.z - 0.5 * (c0.y + c1.x));
-    }
-    let u_post = expected_positive_part(wo.z, wo.xy, post_mean, post_cov);
+    let post = lobe_posterior(mean, cov, sh, roughness);
+    let u_post = expected_positive_part(wo.z, wo.xy, post.mean, post.cov);
     let eu = expected_positive_part(wo.z, wo.xy, mean, cov);
     let dens = gaussian2(sh - mean, total);
     return f0 * dens * (u_post / max(eu, 1e-30)) / (4.0 * pow(h.z, 4.0) * wo.z);
@@ -76,3 +61,35 @@ fn filtered_lobe(f0: f32, roughness: f32, mean: vec2<f32>, cov: vec3<f32>, wo: v
     return 0.0;
 //#endif
 }
+
+//#if specular
+// brdf::lobe_posterior: the facet slopes that carry a lobe, N(s*, Σ*) with s* = s̄ + K(s_h − s̄),
+// Σ* = Σ − KΣ, K = Σ(Σ + σ0²I)⁻¹; the point s_h when both are degenerate.
+struct LobePosterior {
+    mean: vec2<f32>,
+    cov: vec3<f32>,
+}
+
+fn lobe_posterior(mean: vec2<f32>, cov: vec3<f32>, sh: vec2<f32>, roughness: f32) -> LobePosterior {
+    let s0 = max(roughness, 0.0);
+    let total = cov + vec3<f32>(s0 * s0, s0 * s0, 0.0);
+    let det = total.x * total.y - total.z * total.z;
+    var r: LobePosterior;
+    r.mean = sh;
+    r.cov = vec3<f32>(0.0);
+    if (det > 1e-30) {
+        let inv = vec3<f32>(total.y, total.x, -total.z) / det;
+        // K = Σ·C⁻¹ (general 2×2: columns k0, k1).
+        let k0 = vec2<f32>(cov.x * inv.x + cov.z * inv.z, cov.z * inv.x + cov.y * inv.z);
+        let k1 = vec2<f32>(cov.x * inv.z + cov.z * inv.y, cov.z * inv.z + cov.y * inv.y);
+        let d = sh - mean;
+        r.mean = mean + k0 * d.x + k1 * d.y;
+        // KΣ: columns K·(xx, xy) and K·(xy, yy).
+        let c0 = k0 * cov.x + k1 * cov.z;
+        let c1 = k0 * cov.z + k1 * cov.y;
+        r.cov = vec3<f32>(max(cov.x - c0.x, 0.0), max(cov.y - c1.y, 0.0), cov.z - 0.5 * (c0.y + c1.x));
+    }
+    return r;
+}
+//#endif
+
