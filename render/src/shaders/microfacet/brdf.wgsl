@@ -62,7 +62,7 @@ fn filtered_lobe(f0: f32, roughness: f32, mean: vec2<f32>, cov: vec3<f32>, wo: v
 //#endif
 }
 
-//#if specular
+//#if specular|measured
 // brdf::lobe_posterior: the facet slopes that carry a lobe, N(s*, Σ*) with s* = s̄ + K(s_h − s̄),
 // Σ* = Σ − KΣ, K = Σ(Σ + σ0²I)⁻¹; the point s_h when both are degenerate.
 struct LobePosterior {
