@@ -191,6 +191,15 @@ impl EditorApp {
         }
     }
 
+    /// `p` relative to the preset's folder when it lies inside it, as written into the material.
+    fn relative_to_preset(&self, p: &Path) -> String {
+        let dir = self.doc.path.as_ref().and_then(|d| d.parent());
+        dir.and_then(|d| p.strip_prefix(d).ok())
+            .unwrap_or(p)
+            .display()
+            .to_string()
+    }
+
     /// Files dropped on the window: a `.ron` opens (asking first), an `.hdr`/`.exr` becomes the
     /// environment and a `.binary` (MERL) the measured base BRDF (undoable edits).
     pub(super) fn handle_drops(&mut self, ctx: &egui::Context) {
@@ -208,23 +217,13 @@ impl EditorApp {
                 .map(|e| e.to_string_lossy().to_ascii_lowercase());
             if ext.as_deref() == Some("binary") {
                 // A MERL measured BRDF: the base BRDF becomes that file (an undoable edit).
-                let dir = self.doc.path.as_ref().and_then(|p| p.parent());
-                let path = dir
-                    .and_then(|d| p.strip_prefix(d).ok())
-                    .unwrap_or(&p)
-                    .display()
-                    .to_string();
+                let path = self.relative_to_preset(&p);
                 self.doc.material.brdf.measured = Some(path.clone());
                 self.notify(ctx, format!("Measured BRDF: {path}"), false);
             } else if matches!(ext.as_deref(), Some("exr" | "hdr")) {
                 // An environment map: the lighting's environment becomes that file (an undoable
                 // edit); relative to the preset's folder when it lies inside it.
-                let dir = self.doc.path.as_ref().and_then(|p| p.parent());
-                let path = dir
-                    .and_then(|d| p.strip_prefix(d).ok())
-                    .unwrap_or(&p)
-                    .display()
-                    .to_string();
+                let path = self.relative_to_preset(&p);
                 let intensity = self
                     .doc
                     .material
