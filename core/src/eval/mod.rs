@@ -40,6 +40,7 @@ pub mod mixture_bins;
 pub mod naive;
 pub mod pixel;
 pub mod query;
+pub mod ray_variance;
 pub mod shading;
 pub mod view_independent;
 

@@ -32,32 +32,46 @@ impl Evaluator {
         fp: Footprint,
         frame: &DMat3,
     ) -> [f64; 3] {
-        if dir.z >= 0.0 {
-            return [0.0; 3];
-        }
-        let top = self.surface.h_max * 1.001 + 1e-6;
-        let t0 = ((origin.z - top) / -dir.z).max(0.0);
-        let o = origin + dir * t0;
-        let Some(t) = self.lod_march(o, dir, fp) else {
+        let Some((cfg, sun_visible)) = self.pixel_query(origin, dir, wi, fp) else {
             return [0.0; 3];
         };
-        let p = o + dir * t;
-        let sun_visible = wi.z > 0.0 && self.lod_march(p, wi, fp).is_none();
         if !sun_visible && self.environment.is_none() {
             return [0.0; 3];
         }
-        let cfg = FootprintQuery {
-            wo: -dir,
-            wi,
-            x0: DVec2::new(p.x, p.y),
-            footprint: fp,
-        };
         let v = if sun_visible { 1.0 } else { 0.0 };
         match method {
             Method::Naive => self.naive_lit(&cfg, v, frame),
             Method::ViewIndependent => self.view_independent_lit(&cfg, v, frame),
             Method::Filtered => self.filtered_lit(&cfg, v, frame),
         }
+    }
+
+    /// Where an analytic view's pixel is evaluated: the camera ray (origin, unit dir) meets the
+    /// level-of-detail surface at the query's centre, with the pixel's footprint `fp`; and whether
+    /// a shadow ray on h̄ from there reaches the light. None where the ray misses (sky).
+    pub fn pixel_query(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        wi: DVec3,
+        fp: Footprint,
+    ) -> Option<(FootprintQuery, bool)> {
+        if dir.z >= 0.0 {
+            return None;
+        }
+        let top = self.surface.h_max * 1.001 + 1e-6;
+        let t0 = ((origin.z - top) / -dir.z).max(0.0);
+        let o = origin + dir * t0;
+        let t = self.lod_march(o, dir, fp)?;
+        let p = o + dir * t;
+        let sun_visible = wi.z > 0.0 && self.lod_march(p, wi, fp).is_none();
+        let cfg = FootprintQuery {
+            wo: -dir,
+            wi,
+            x0: DVec2::new(p.x, p.y),
+            footprint: fp,
+        };
+        Some((cfg, sun_visible))
     }
 
     /// One pixel of an analytic view of the plane: pixel centre `p` of a `width × height` image of
