@@ -41,6 +41,7 @@ pub mod naive;
 pub mod pixel;
 pub mod query;
 pub mod ray_variance;
+pub mod sampling_plan;
 pub mod shading;
 pub mod view_independent;
 

@@ -378,4 +378,88 @@ mod tests {
             }
         }
     }
+
+    /// #18 §1's comparison on the CPU: image MSE at equal rays of uniform sampling, per-pixel
+    /// counts from σ̂ (step 1), and the sampling plan on 2- and 4-pixel lattices, against a
+    /// reference of `REF` rays a pixel; printed as the uniform ray count that reaches the same
+    /// error over the plan's (rays saved at equal error).
+    #[test]
+    #[ignore]
+    fn print_sampling_plan_gains() {
+        use crate::eval::sampling_plan::SamplingPlan;
+        const REF: usize = 2000;
+        const Y: [f64; 3] = [0.2126, 0.7152, 0.0722];
+        let lum = |v: [f64; 3]| (0..3).map(|c| Y[c] * v[c]).sum::<f64>();
+        for name in [
+            "default",
+            "dirt-in-crevices",
+            "snow-under-sky",
+            "bumpy-specular",
+        ] {
+            let p = Evaluator::new(&preset(name)).unwrap();
+            for (elev, dist) in [(60.0, 3.0), (80.0, 3.0), (75.0, 12.0)] {
+                let camera = p.surface.clear_camera(&crate::scene::camera::Camera {
+                    elevation_deg: elev,
+                    distance: dist,
+                    ..Default::default()
+                });
+                let wi = direction(30f64.to_radians(), 90f64.to_radians());
+                let (w, h) = (32usize, 24usize);
+                let (mut fm, mut sdp, mut mu, mut sd) = (vec![], vec![], vec![], vec![]);
+                for j in 0..h {
+                    for i in 0..w {
+                        let px = DVec2::new(i as f64 + 0.5, j as f64 + 0.5);
+                        let q =
+                            camera
+                                .plane_footprint(px, w as u32, h as u32)
+                                .and_then(|(_, cov)| {
+                                    let ray = camera.ray(px, w as u32, h as u32);
+                                    p.pixel_query(ray.origin, ray.dir, wi, Footprint { cov })
+                                });
+                        let Some((cfg, vis)) = q else {
+                            fm.push(0.0);
+                            sdp.push(0.0);
+                            mu.push(0.0);
+                            sd.push(0.0);
+                            continue;
+                        };
+                        let v = if vis { 1.0 } else { 0.0 };
+                        fm.push(lum(p.filtered_lit(&cfg, v, &DMat3::IDENTITY)));
+                        sdp.push(p.predicted_ray_moments(&cfg).luminance_variance().sqrt());
+                        let e = p.ground_truth(&cfg, REF, 11);
+                        mu.push(lum(e.mean));
+                        sd.push(lum(e.std_error) * (REF as f64).sqrt());
+                    }
+                }
+                let n = (w * h) as f64;
+                let covered = sd.iter().filter(|s| **s > 0.0).count() as f64;
+                let mean_var = sd.iter().map(|s| s * s).sum::<f64>() / covered;
+                let mut line = format!("{name:18} {elev:4}° d {dist:4}:");
+                for rpp in [4.0, 16.0, 64.0] {
+                    // Uniform over the pixels that see the surface (sky pixels get the floor of one ray).
+                    let flat: Vec<f64> = sd
+                        .iter()
+                        .map(|s| if *s > 0.0 { 1.0 } else { 0.0 })
+                        .collect();
+                    let mut cells = vec![];
+                    for (mean_pred, sd_pred, step) in [
+                        (&fm, &flat, 1),
+                        (&fm, &sdp, 1),
+                        (&fm, &sdp, 2),
+                        (&fm, &sdp, 4),
+                    ] {
+                        let plan = SamplingPlan::new(w, h, mean_pred, sd_pred, rpp, step);
+                        let mse = plan.expected_mse(&mu, &sd);
+                        // Uniform over `covered` pixels reaches this MSE with mean_var·n/(covered·mse) rays a
+                        // covered pixel (its MSE is averaged over all n).
+                        let equal =
+                            mean_var * covered / (n * mse) / (plan.total_rays() as f64 / covered);
+                        cells.push(format!("{equal:.2}"));
+                    }
+                    line += &format!("  rpp {rpp}: {}", cells.join("/"));
+                }
+                println!("{line}");
+            }
+        }
+    }
 }

@@ -1,0 +1,254 @@
+//! Where an adaptive ground truth spends its rays over an image [BSSBH13 Secs. 2.4, 3] (#18 §1):
+//! which pixels are shaded at all, how many rays each gets, and how the others are filled in.
+//!
+//! BSSBH13 shade a sparse set of pixels where the image's predicted bandwidth is low and up-sample
+//! the rest [Sec. 3.2], and give each shaded pixel rays in proportion to its integrand's predicted
+//! variance [Sec. 2.4]. Lodestone predicts both from the statistical model: the filtered view is the
+//! truth's expected image (its local variation is the image-space bandwidth, measured directly
+//! instead of propagated through the transport operators), and
+//! [`Evaluator::predicted_ray_moments`](crate::eval::Evaluator::predicted_ray_moments) is one
+//! ray's variance.
+//!
+//! The plan, for a `step`-pixel lattice (every pixel with both coordinates a multiple of `step`,
+//! plus the last row and column, is always shaded):
+//! 1. a pixel off the lattice is interpolated (bilinearly from its cell's four lattice corners)
+//!    when the predicted image's interpolation error there, `b = |Σ w_k F_k − F|`, is below the
+//!    noise the pixel would have if shaded with the budget's average ray count, `b² ≤ σ̂²/n̄`;
+//!    otherwise it is shaded;
+//! 2. the rays go to the shaded pixels in proportion to σ̂ (the allocation that minimises
+//!    `Σ σ²/n` for a fixed total), at least one each.
+//!
+//! Uniform sampling is the plan with `step = 1` and equal σ̂.
+
+/// Which pixels a ground truth shades, with how many rays, and how the rest are reconstructed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SamplingPlan {
+    /// Image width, pixels.
+    pub width: usize,
+    /// Image height, pixels.
+    pub height: usize,
+    /// Lattice step (pixels).
+    pub step: usize,
+    /// Rays per pixel, row-major; 0 for a pixel filled by interpolation.
+    pub rays: Vec<u32>,
+}
+
+/// The lattice coordinates bracketing `i` on a `step` lattice of `n` pixels, and `i`'s weight on
+/// the upper one: the last pixel is a lattice point too.
+fn bracket(i: usize, step: usize, n: usize) -> (usize, usize, f64) {
+    let lo = (i / step) * step;
+    let hi = (lo + step).min(n - 1);
+    if hi <= lo {
+        return (lo, lo, 0.0);
+    }
+    (lo, hi, (i - lo) as f64 / (hi - lo) as f64)
+}
+
+impl SamplingPlan {
+    /// The plan for a `width × height` image with predicted mean `mean` and predicted per-ray
+    /// standard deviation `sd` (row-major, one value per pixel, e.g. luminance; missing values count as 0), `rays_per_pixel`
+    /// rays on average and lattice `step` (1: every pixel shaded). Non-finite predictions (and
+    /// negative deviations) count as 0; empty images give an empty plan.
+    pub fn new(
+        width: usize,
+        height: usize,
+        mean: &[f64],
+        sd: &[f64],
+        rays_per_pixel: f64,
+        step: usize,
+    ) -> Self {
+        let n = width * height;
+        let step = step.max(1);
+        let clean = |v: f64| if v.is_finite() && v > 0.0 { v } else { 0.0 };
+        // A missing value counts as 0, as a non-finite one.
+        let at = |s: &[f64], p: usize| clean(s.get(p).copied().unwrap_or(0.0));
+        let mean_at = |p: usize| {
+            mean.get(p)
+                .copied()
+                .filter(|v| v.is_finite())
+                .unwrap_or(0.0)
+        };
+        let budget = (clean(rays_per_pixel) * n as f64).max(n as f64);
+        let mut shaded = vec![false; n];
+        for y in 0..height {
+            for x in 0..width {
+                let on_lattice =
+                    (x % step == 0 || x == width - 1) && (y % step == 0 || y == height - 1);
+                let p = y * width + x;
+                if on_lattice {
+                    shaded[p] = true;
+                    continue;
+                }
+                let interp = Self::interpolate_at(width, height, step, x, y, mean_at);
+                let b = interp - mean_at(p);
+                let noise = at(sd, p).powi(2) / clean(rays_per_pixel).max(1.0);
+                shaded[p] = b * b > noise;
+            }
+        }
+        let count = shaded.iter().filter(|s| **s).count().max(1);
+        let total_sd: f64 = (0..n).filter(|p| shaded[*p]).map(|p| at(sd, p)).sum();
+        let mut rays = vec![0u32; n];
+        for p in 0..n {
+            if !shaded[p] {
+                continue;
+            }
+            let share = if total_sd > 0.0 {
+                at(sd, p) / total_sd
+            } else {
+                1.0 / count as f64
+            };
+            rays[p] = (budget * share).round().clamp(1.0, u32::MAX as f64) as u32;
+        }
+        Self {
+            width,
+            height,
+            step,
+            rays,
+        }
+    }
+
+    /// Bilinear interpolation at (x, y) of `value` at its cell's four lattice corners.
+    fn interpolate_at(
+        width: usize,
+        height: usize,
+        step: usize,
+        x: usize,
+        y: usize,
+        value: impl Fn(usize) -> f64,
+    ) -> f64 {
+        let (x0, x1, tx) = bracket(x, step, width);
+        let (y0, y1, ty) = bracket(y, step, height);
+        let v = |xx: usize, yy: usize| value(yy * width + xx);
+        (1.0 - ty) * ((1.0 - tx) * v(x0, y0) + tx * v(x1, y0))
+            + ty * ((1.0 - tx) * v(x0, y1) + tx * v(x1, y1))
+    }
+
+    /// The interpolation weights of pixel (x, y) on lattice pixels (index, weight): itself with
+    /// weight 1 when it is shaded.
+    pub fn weights(&self, x: usize, y: usize) -> Vec<(usize, f64)> {
+        let p = y * self.width + x;
+        if self.rays[p] > 0 {
+            return vec![(p, 1.0)];
+        }
+        let (x0, x1, tx) = bracket(x, self.step, self.width);
+        let (y0, y1, ty) = bracket(y, self.step, self.height);
+        [
+            (x0, y0, (1.0 - tx) * (1.0 - ty)),
+            (x1, y0, tx * (1.0 - ty)),
+            (x0, y1, (1.0 - tx) * ty),
+            (x1, y1, tx * ty),
+        ]
+        .into_iter()
+        .filter(|c| c.2 > 0.0)
+        .map(|(xx, yy, w)| (yy * self.width + xx, w))
+        .collect()
+    }
+
+    /// The image from the shaded pixels' estimates (`shaded[p]` read only where `rays[p] > 0`).
+    pub fn reconstruct(&self, shaded: &[f64]) -> Vec<f64> {
+        let mut out = vec![0.0; self.width * self.height];
+        for y in 0..self.height {
+            for x in 0..self.width {
+                out[y * self.width + x] = self
+                    .weights(x, y)
+                    .into_iter()
+                    .map(|(q, w)| w * shaded[q])
+                    .sum();
+            }
+        }
+        out
+    }
+
+    /// Expected mean squared error of [`Self::reconstruct`] against the true image `mean`, when
+    /// each shaded pixel averages its rays of per-ray standard deviation `sd`: per pixel the
+    /// interpolation bias squared plus `Σ w_k² sd_k²/n_k`.
+    pub fn expected_mse(&self, mean: &[f64], sd: &[f64]) -> f64 {
+        let mut total = 0.0;
+        for y in 0..self.height {
+            for x in 0..self.width {
+                let p = y * self.width + x;
+                let mut est = 0.0;
+                let mut var = 0.0;
+                for (q, w) in self.weights(x, y) {
+                    est += w * mean[q];
+                    var += w * w * sd[q] * sd[q] / f64::from(self.rays[q].max(1));
+                }
+                total += (est - mean[p]).powi(2) + var;
+            }
+        }
+        total / (self.width * self.height).max(1) as f64
+    }
+
+    /// Rays the plan traces.
+    pub fn total_rays(&self) -> u64 {
+        self.rays.iter().map(|r| u64::from(*r)).sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A smooth image is interpolated between lattice points and costs only their rays; a
+    /// reconstruction of exact lattice values is exact for a bilinear image.
+    #[test]
+    fn a_bilinear_image_is_reconstructed_exactly_from_its_lattice() {
+        let (w, h) = (9, 7);
+        let f = |x: usize, y: usize| 1.0 + 0.3 * x as f64 - 0.2 * y as f64 + 0.01 * (x * y) as f64;
+        let mean: Vec<f64> = (0..w * h).map(|p| f(p % w, p / w)).collect();
+        let sd = vec![0.5; w * h];
+        let plan = SamplingPlan::new(w, h, &mean, &sd, 16.0, 4);
+        // Lattice: x ∈ {0, 4, 8}, y ∈ {0, 4, 6}: nine pixels, nothing else shaded.
+        assert_eq!(plan.rays.iter().filter(|r| **r > 0).count(), 9);
+        let rec = plan.reconstruct(&mean);
+        for p in 0..w * h {
+            assert!((rec[p] - mean[p]).abs() < 1e-12, "pixel {p}");
+        }
+        // The whole budget on the nine: 16·63/9 = 112 rays each.
+        assert_eq!(plan.total_rays(), 9 * 112);
+        // No bias; the variance of each shaded pixel shrinks by its 112 rays.
+        let mse = plan.expected_mse(&mean, &sd);
+        assert!(mse < 0.25 / 112.0 + 1e-15 && mse > 0.0);
+    }
+
+    /// An edge the lattice cannot interpolate is shaded; equal σ̂ with step 1 is uniform sampling.
+    #[test]
+    fn edges_are_shaded_and_step_one_is_uniform() {
+        let (w, h) = (9, 9);
+        let mean: Vec<f64> = (0..w * h)
+            .map(|p| if p % w < 5 { 0.0 } else { 1.0 })
+            .collect();
+        let sd = vec![0.1; w * h];
+        let plan = SamplingPlan::new(w, h, &mean, &sd, 4.0, 4);
+        for y in 0..h {
+            // Pixel x = 5 lies between lattice columns 4 (0) and 8 (1): interpolated 0.25, off by 0.75.
+            assert!(plan.rays[y * w + 5] > 0);
+            // x = 1 lies between 0 and 4, both 0: interpolated exactly.
+            assert_eq!(plan.rays[y * w + 1], 0);
+        }
+        let uniform = SamplingPlan::new(w, h, &mean, &sd, 4.0, 1);
+        assert!(uniform.rays.iter().all(|r| *r == 4));
+        assert!((uniform.expected_mse(&mean, &sd) - 0.01 / 4.0).abs() < 1e-15);
+    }
+
+    /// Rays follow σ̂: a pixel predicted three times as noisy gets three times the rays.
+    #[test]
+    fn rays_are_in_proportion_to_the_predicted_deviation() {
+        let mean = vec![0.0; 4];
+        let sd = [1.0, 3.0, 1.0, 3.0];
+        let plan = SamplingPlan::new(2, 2, &mean, &sd, 8.0, 1);
+        assert_eq!(plan.rays, vec![4, 12, 4, 12]);
+    }
+
+    /// Garbage predictions and empty images give a plan, not a panic.
+    #[test]
+    fn hostile_predictions_give_a_plan() {
+        let mean = [f64::NAN, f64::INFINITY, -1.0, 0.0];
+        let sd = [f64::NAN, -2.0, f64::INFINITY, 0.0];
+        let plan = SamplingPlan::new(2, 2, &mean, &sd, f64::NAN, 0);
+        assert!(plan.rays.iter().all(|r| *r >= 1));
+        let empty = SamplingPlan::new(0, 0, &[], &[], 4.0, 2);
+        assert_eq!(empty.total_rays(), 0);
+        assert_eq!(empty.expected_mse(&[], &[]), 0.0);
+    }
+}
