@@ -449,12 +449,17 @@ mod tests {
                         (&fm, &sdp, 4),
                     ] {
                         let plan = SamplingPlan::new(w, h, mean_pred, sd_pred, rpp, step);
-                        let mse = plan.expected_mse(&mu, &sd);
-                        // Uniform over `covered` pixels reaches this MSE with mean_var·n/(covered·mse) rays a
-                        // covered pixel (its MSE is averaged over all n).
-                        let equal =
-                            mean_var * covered / (n * mse) / (plan.total_rays() as f64 / covered);
-                        cells.push(format!("{equal:.2}"));
+                        // Uniform over `covered` pixels reaches an MSE with mean_var·n/(covered·mse)
+                        // rays a covered pixel (its MSE is averaged over all n).
+                        let per = plan.total_rays() as f64 / covered;
+                        let equal = |mse: f64| mean_var * covered / (n * mse) / per;
+                        let plain = equal(plan.expected_mse(&mu, &sd, None));
+                        if step == 1 {
+                            cells.push(format!("{plain:.2}"));
+                        } else {
+                            let guided = equal(plan.expected_mse(&mu, &sd, Some(&fm)));
+                            cells.push(format!("{plain:.2}({guided:.2})"));
+                        }
                     }
                     line += &format!("  rpp {rpp}: {}", cells.join("/"));
                 }

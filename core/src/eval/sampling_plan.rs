@@ -145,32 +145,39 @@ impl SamplingPlan {
     }
 
     /// The image from the shaded pixels' estimates (`shaded[p]` read only where `rays[p] > 0`).
-    pub fn reconstruct(&self, shaded: &[f64]) -> Vec<f64> {
+    /// With a `guide` (the filtered image: the truth's prediction), an interpolated pixel is the
+    /// guide there plus the interpolated residual `Σ w_k (x_k − guide_k)`, so what the prediction
+    /// already knows is not blurred; without, the plain bilinear interpolation.
+    pub fn reconstruct(&self, shaded: &[f64], guide: Option<&[f64]>) -> Vec<f64> {
+        let g = |q: usize| guide.and_then(|g| g.get(q).copied()).unwrap_or(0.0);
         let mut out = vec![0.0; self.width * self.height];
         for y in 0..self.height {
             for x in 0..self.width {
-                out[y * self.width + x] = self
-                    .weights(x, y)
-                    .into_iter()
-                    .map(|(q, w)| w * shaded[q])
-                    .sum();
+                let p = y * self.width + x;
+                out[p] = g(p)
+                    + self
+                        .weights(x, y)
+                        .into_iter()
+                        .map(|(q, w)| w * (shaded[q] - g(q)))
+                        .sum::<f64>();
             }
         }
         out
     }
 
-    /// Expected mean squared error of [`Self::reconstruct`] against the true image `mean`, when
-    /// each shaded pixel averages its rays of per-ray standard deviation `sd`: per pixel the
-    /// interpolation bias squared plus `Σ w_k² sd_k²/n_k`.
-    pub fn expected_mse(&self, mean: &[f64], sd: &[f64]) -> f64 {
+    /// Expected mean squared error of [`Self::reconstruct`] (with the same `guide`) against the
+    /// true image `mean`, when each shaded pixel averages its rays of per-ray standard deviation
+    /// `sd`: per pixel the interpolation bias squared plus `Σ w_k² sd_k²/n_k`.
+    pub fn expected_mse(&self, mean: &[f64], sd: &[f64], guide: Option<&[f64]>) -> f64 {
+        let g = |q: usize| guide.and_then(|g| g.get(q).copied()).unwrap_or(0.0);
         let mut total = 0.0;
         for y in 0..self.height {
             for x in 0..self.width {
                 let p = y * self.width + x;
-                let mut est = 0.0;
+                let mut est = g(p);
                 let mut var = 0.0;
                 for (q, w) in self.weights(x, y) {
-                    est += w * mean[q];
+                    est += w * (mean[q] - g(q));
                     var += w * w * sd[q] * sd[q] / f64::from(self.rays[q].max(1));
                 }
                 total += (est - mean[p]).powi(2) + var;
@@ -200,14 +207,14 @@ mod tests {
         let plan = SamplingPlan::new(w, h, &mean, &sd, 16.0, 4);
         // Lattice: x ∈ {0, 4, 8}, y ∈ {0, 4, 6}: nine pixels, nothing else shaded.
         assert_eq!(plan.rays.iter().filter(|r| **r > 0).count(), 9);
-        let rec = plan.reconstruct(&mean);
+        let rec = plan.reconstruct(&mean, None);
         for p in 0..w * h {
             assert!((rec[p] - mean[p]).abs() < 1e-12, "pixel {p}");
         }
         // The whole budget on the nine: 16·63/9 = 112 rays each.
         assert_eq!(plan.total_rays(), 9 * 112);
         // No bias; the variance of each shaded pixel shrinks by its 112 rays.
-        let mse = plan.expected_mse(&mean, &sd);
+        let mse = plan.expected_mse(&mean, &sd, None);
         assert!(mse < 0.25 / 112.0 + 1e-15 && mse > 0.0);
     }
 
@@ -228,7 +235,7 @@ mod tests {
         }
         let uniform = SamplingPlan::new(w, h, &mean, &sd, 4.0, 1);
         assert!(uniform.rays.iter().all(|r| *r == 4));
-        assert!((uniform.expected_mse(&mean, &sd) - 0.01 / 4.0).abs() < 1e-15);
+        assert!((uniform.expected_mse(&mean, &sd, None) - 0.01 / 4.0).abs() < 1e-15);
     }
 
     /// Rays follow σ̂: a pixel predicted three times as noisy gets three times the rays.
@@ -249,6 +256,33 @@ mod tests {
         assert!(plan.rays.iter().all(|r| *r >= 1));
         let empty = SamplingPlan::new(0, 0, &[], &[], 4.0, 2);
         assert_eq!(empty.total_rays(), 0);
-        assert_eq!(empty.expected_mse(&[], &[]), 0.0);
+        assert_eq!(empty.expected_mse(&[], &[], None), 0.0);
+    }
+
+    /// With the true image as the guide, interpolation has no bias whatever the image: an edge
+    /// the lattice misses is reconstructed exactly from exact lattice values.
+    #[test]
+    fn a_guide_carries_what_the_lattice_misses() {
+        let (w, h) = (9, 9);
+        let mean: Vec<f64> = (0..w * h)
+            .map(|p| if p % w < 5 { 0.2 } else { 1.0 } + 0.05 * (p / w) as f64)
+            .collect();
+        let sd = vec![0.0; w * h];
+        // Zero deviations: the rule interpolates wherever the plain bilinear error is 0 only.
+        let plan = SamplingPlan::new(w, h, &mean, &sd, 4.0, 4);
+        let guide: Vec<f64> = mean.iter().map(|m| m + 0.3).collect();
+        let rec = plan.reconstruct(&mean, Some(&guide));
+        for p in 0..w * h {
+            assert!((rec[p] - mean[p]).abs() < 1e-12, "pixel {p}");
+        }
+        // Only the lattice shaded (a flat prediction): 8·81/9 = 72 rays on each of its nine.
+        let sd = vec![0.2; w * h];
+        let coarse = SamplingPlan::new(w, h, &vec![0.0; w * h], &sd, 8.0, 4);
+        assert_eq!(coarse.rays.iter().filter(|r| **r > 0).count(), 9);
+        // Unguided, the edge is blurred; guided, only the lattice's noise is left.
+        let blurred = coarse.expected_mse(&mean, &sd, None);
+        let guided = coarse.expected_mse(&mean, &sd, Some(&guide));
+        assert!(guided <= 0.04 / 72.0 + 1e-15, "{guided}");
+        assert!(blurred > 10.0 * guided, "{blurred} {guided}");
     }
 }
