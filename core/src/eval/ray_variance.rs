@@ -458,7 +458,25 @@ mod tests {
                             cells.push(format!("{plain:.2}"));
                         } else {
                             let guided = equal(plan.expected_mse(&mu, &sd, Some(&fm)));
-                            cells.push(format!("{plain:.2}({guided:.2})"));
+                            // A posteriori: a quarter of the budget on the first plan, its
+                            // estimates drawn around the reference, then the refined plan.
+                            let first =
+                                SamplingPlan::new(w, h, mean_pred, sd_pred, rpp / 4.0, step);
+                            let mut rng = 0x5EED_u64 + step as u64;
+                            let est: Vec<f64> = (0..w * h)
+                                .map(|q| {
+                                    let k = f64::from(first.rays[q].max(1));
+                                    mu[q]
+                                        + sd[q] / k.sqrt()
+                                            * crate::math::random::standard_normal(&mut rng)
+                                })
+                                .collect();
+                            let refined = first.refine(&est, sd_pred, &fm, rpp);
+                            let per_r = refined.total_rays() as f64 / covered;
+                            let r = mean_var * covered
+                                / (n * refined.expected_mse(&mu, &sd, Some(&fm)))
+                                / per_r;
+                            cells.push(format!("{plain:.2}({guided:.2},{r:.2})"));
                         }
                     }
                     line += &format!("  rpp {rpp}: {}", cells.join("/"));

@@ -107,6 +107,95 @@ impl SamplingPlan {
         }
     }
 
+    /// The a posteriori refinement [BSSBH13 Sec. 3.2, hierarchically]: after this plan's rays gave
+    /// `estimates` (read where `rays > 0`), every lattice cell whose four corners' residuals from
+    /// the prediction, `r_k = estimates_k − guide_k`, spread by more than their own noise
+    /// (`Var_k(r) − mean_k(sd_k²/n_k)`) and more than the noise a pixel would have at the final
+    /// budget (`σ̂²/rays_per_pixel`, σ̂ the cell's largest `sd`) has all its pixels shaded: the
+    /// truth departs there from its prediction in a way the lattice cannot interpolate (the
+    /// micro-geometry's own realisation on near views). The rays of the refined plan total
+    /// `rays_per_pixel` a pixel over the image, in proportion to `sd`, and no shaded pixel gets
+    /// fewer than it already has.
+    pub fn refine(
+        &self,
+        estimates: &[f64],
+        sd: &[f64],
+        guide: &[f64],
+        rays_per_pixel: f64,
+    ) -> Self {
+        let (w, h, step) = (self.width, self.height, self.step);
+        let n = w * h;
+        let clean = |v: f64| if v.is_finite() && v > 0.0 { v } else { 0.0 };
+        let val = |s: &[f64], p: usize| s.get(p).copied().filter(|v| v.is_finite()).unwrap_or(0.0);
+        let mut shaded: Vec<bool> = self.rays.iter().map(|r| *r > 0).collect();
+        let lattice = |len: usize| {
+            let mut v: Vec<usize> = (0..len).step_by(step).collect();
+            if v.last() != Some(&(len - 1)) {
+                v.push(len - 1);
+            }
+            v
+        };
+        if n > 0 {
+            let (xs, ys) = (lattice(w), lattice(h));
+            for cy in ys.windows(2) {
+                for cx in xs.windows(2) {
+                    let corners = [
+                        (cx[0], cy[0]),
+                        (cx[1], cy[0]),
+                        (cx[0], cy[1]),
+                        (cx[1], cy[1]),
+                    ];
+                    let idx = corners.map(|(x, y)| y * w + x);
+                    if idx.iter().any(|p| self.rays[*p] == 0) {
+                        continue;
+                    }
+                    let r = idx.map(|p| val(estimates, p) - val(guide, p));
+                    let mean = r.iter().sum::<f64>() / 4.0;
+                    let spread = r.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / 3.0;
+                    let noise = idx
+                        .iter()
+                        .map(|p| clean(val(sd, *p)).powi(2) / f64::from(self.rays[*p]))
+                        .sum::<f64>()
+                        / 4.0;
+                    let sigma = idx.iter().map(|p| clean(val(sd, *p))).fold(0.0, f64::max);
+                    let target = sigma * sigma / clean(rays_per_pixel).max(1.0);
+                    if spread - noise > target {
+                        for y in cy[0]..=cy[1] {
+                            for x in cx[0]..=cx[1] {
+                                shaded[y * w + x] = true;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let budget = (clean(rays_per_pixel) * n as f64).max(n as f64);
+        let count = shaded.iter().filter(|s| **s).count().max(1);
+        let total_sd: f64 = (0..n)
+            .filter(|p| shaded[*p])
+            .map(|p| clean(val(sd, p)))
+            .sum();
+        let rays = (0..n)
+            .map(|p| {
+                if !shaded[p] {
+                    return 0;
+                }
+                let share = if total_sd > 0.0 {
+                    clean(val(sd, p)) / total_sd
+                } else {
+                    1.0 / count as f64
+                };
+                ((budget * share).round().clamp(1.0, u32::MAX as f64) as u32).max(self.rays[p])
+            })
+            .collect();
+        Self {
+            width: w,
+            height: h,
+            step,
+            rays,
+        }
+    }
+
     /// Bilinear interpolation at (x, y) of `value` at its cell's four lattice corners.
     fn interpolate_at(
         width: usize,
@@ -284,5 +373,32 @@ mod tests {
         let guided = coarse.expected_mse(&mean, &sd, Some(&guide));
         assert!(guided <= 0.04 / 72.0 + 1e-15, "{guided}");
         assert!(blurred > 10.0 * guided, "{blurred} {guided}");
+    }
+
+    /// A residual the prediction misses inside one cell gets that cell shaded; a residual the
+    /// noise explains does not.
+    #[test]
+    fn refinement_shades_cells_whose_residual_is_not_smooth() {
+        let (w, h) = (9, 9);
+        let guide = vec![0.5; w * h];
+        let sd = vec![0.1; w * h];
+        let first = SamplingPlan::new(w, h, &guide, &sd, 2.0, 4);
+        assert_eq!(first.rays.iter().filter(|r| **r > 0).count(), 9);
+        // The truth's residual from the guide: 0 except +0.4 at corner (4, 4), which the four
+        // cells around it share.
+        let mut est = guide.clone();
+        est[4 * w + 4] += 0.4;
+        let refined = first.refine(&est, &sd, &guide, 16.0);
+        assert!(
+            refined.rays.iter().all(|r| *r > 0),
+            "all four cells touch (4, 4)"
+        );
+        // The same bump at noise level (0.1/√18 a corner) leaves the lattice alone.
+        let mut quiet = guide.clone();
+        quiet[4 * w + 4] += 0.01;
+        let kept = first.refine(&quiet, &sd, &guide, 16.0);
+        assert_eq!(kept.rays.iter().filter(|r| **r > 0).count(), 9);
+        assert!(kept.rays.iter().zip(&first.rays).all(|(a, b)| a >= b));
+        assert!(kept.total_rays() >= 16 * 81 - 9 && kept.total_rays() <= 16 * 81 + 9);
     }
 }
