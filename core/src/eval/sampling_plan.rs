@@ -33,6 +33,43 @@ pub struct SamplingPlan {
     pub rays: Vec<u32>,
 }
 
+/// `v` where it is finite and positive, else 0 (a deviation, a ray count).
+fn positive(v: f64) -> f64 {
+    if v.is_finite() && v > 0.0 { v } else { 0.0 }
+}
+
+/// `s[p]` where it exists and is finite, else 0.
+fn value(s: &[f64], p: usize) -> f64 {
+    s.get(p).copied().filter(|v| v.is_finite()).unwrap_or(0.0)
+}
+
+/// Rays for the `shaded` pixels: `rays_per_pixel` a pixel over the whole image (at least one a
+/// pixel), in proportion to `sd` (equal shares where every `sd` is 0), at least one each and at
+/// least `floor[p]` where given; 0 for the others.
+fn allocate(shaded: &[bool], sd: &[f64], rays_per_pixel: f64, floor: &[u32]) -> Vec<u32> {
+    let n = shaded.len();
+    let budget = (positive(rays_per_pixel) * n as f64).max(n as f64);
+    let count = shaded.iter().filter(|s| **s).count().max(1);
+    let total_sd: f64 = (0..n)
+        .filter(|p| shaded[*p])
+        .map(|p| positive(value(sd, p)))
+        .sum();
+    (0..n)
+        .map(|p| {
+            if !shaded[p] {
+                return 0;
+            }
+            let share = if total_sd > 0.0 {
+                positive(value(sd, p)) / total_sd
+            } else {
+                1.0 / count as f64
+            };
+            let r = (budget * share).round().clamp(1.0, u32::MAX as f64) as u32;
+            r.max(floor.get(p).copied().unwrap_or(0))
+        })
+        .collect()
+}
+
 /// The lattice coordinates bracketing `i` on a `step` lattice of `n` pixels, and `i`'s weight on
 /// the upper one: the last pixel is a lattice point too.
 fn bracket(i: usize, step: usize, n: usize) -> (usize, usize, f64) {
@@ -59,16 +96,7 @@ impl SamplingPlan {
     ) -> Self {
         let n = width * height;
         let step = step.max(1);
-        let clean = |v: f64| if v.is_finite() && v > 0.0 { v } else { 0.0 };
-        // A missing value counts as 0, as a non-finite one.
-        let at = |s: &[f64], p: usize| clean(s.get(p).copied().unwrap_or(0.0));
-        let mean_at = |p: usize| {
-            mean.get(p)
-                .copied()
-                .filter(|v| v.is_finite())
-                .unwrap_or(0.0)
-        };
-        let budget = (clean(rays_per_pixel) * n as f64).max(n as f64);
+        let mean_at = |p: usize| value(mean, p);
         let mut shaded = vec![false; n];
         for y in 0..height {
             for x in 0..width {
@@ -81,24 +109,11 @@ impl SamplingPlan {
                 }
                 let interp = Self::interpolate_at(width, height, step, x, y, mean_at);
                 let b = interp - mean_at(p);
-                let noise = at(sd, p).powi(2) / clean(rays_per_pixel).max(1.0);
+                let noise = positive(value(sd, p)).powi(2) / positive(rays_per_pixel).max(1.0);
                 shaded[p] = b * b > noise;
             }
         }
-        let count = shaded.iter().filter(|s| **s).count().max(1);
-        let total_sd: f64 = (0..n).filter(|p| shaded[*p]).map(|p| at(sd, p)).sum();
-        let mut rays = vec![0u32; n];
-        for p in 0..n {
-            if !shaded[p] {
-                continue;
-            }
-            let share = if total_sd > 0.0 {
-                at(sd, p) / total_sd
-            } else {
-                1.0 / count as f64
-            };
-            rays[p] = (budget * share).round().clamp(1.0, u32::MAX as f64) as u32;
-        }
+        let rays = allocate(&shaded, sd, rays_per_pixel, &[]);
         Self {
             width,
             height,
@@ -125,8 +140,6 @@ impl SamplingPlan {
     ) -> Self {
         let (w, h, step) = (self.width, self.height, self.step);
         let n = w * h;
-        let clean = |v: f64| if v.is_finite() && v > 0.0 { v } else { 0.0 };
-        let val = |s: &[f64], p: usize| s.get(p).copied().filter(|v| v.is_finite()).unwrap_or(0.0);
         let mut shaded: Vec<bool> = self.rays.iter().map(|r| *r > 0).collect();
         let lattice = |len: usize| {
             let mut v: Vec<usize> = (0..len).step_by(step).collect();
@@ -149,16 +162,19 @@ impl SamplingPlan {
                     if idx.iter().any(|p| self.rays[*p] == 0) {
                         continue;
                     }
-                    let r = idx.map(|p| val(estimates, p) - val(guide, p));
+                    let r = idx.map(|p| value(estimates, p) - value(guide, p));
                     let mean = r.iter().sum::<f64>() / 4.0;
                     let spread = r.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / 3.0;
                     let noise = idx
                         .iter()
-                        .map(|p| clean(val(sd, *p)).powi(2) / f64::from(self.rays[*p]))
+                        .map(|p| positive(value(sd, *p)).powi(2) / f64::from(self.rays[*p]))
                         .sum::<f64>()
                         / 4.0;
-                    let sigma = idx.iter().map(|p| clean(val(sd, *p))).fold(0.0, f64::max);
-                    let target = sigma * sigma / clean(rays_per_pixel).max(1.0);
+                    let sigma = idx
+                        .iter()
+                        .map(|p| positive(value(sd, *p)))
+                        .fold(0.0, f64::max);
+                    let target = sigma * sigma / positive(rays_per_pixel).max(1.0);
                     if spread - noise > target {
                         for y in cy[0]..=cy[1] {
                             for x in cx[0]..=cx[1] {
@@ -169,25 +185,7 @@ impl SamplingPlan {
                 }
             }
         }
-        let budget = (clean(rays_per_pixel) * n as f64).max(n as f64);
-        let count = shaded.iter().filter(|s| **s).count().max(1);
-        let total_sd: f64 = (0..n)
-            .filter(|p| shaded[*p])
-            .map(|p| clean(val(sd, p)))
-            .sum();
-        let rays = (0..n)
-            .map(|p| {
-                if !shaded[p] {
-                    return 0;
-                }
-                let share = if total_sd > 0.0 {
-                    clean(val(sd, p)) / total_sd
-                } else {
-                    1.0 / count as f64
-                };
-                ((budget * share).round().clamp(1.0, u32::MAX as f64) as u32).max(self.rays[p])
-            })
-            .collect();
+        let rays = allocate(&shaded, sd, rays_per_pixel, &self.rays);
         Self {
             width: w,
             height: h,
