@@ -35,8 +35,8 @@
 use crate::renderer::LinearImage;
 use lodestone_core::material::colormap::Gradient;
 
-/// Rec. 709 luminance weights (linear RGB). `view.wgsl` accumulates `Y²` with the same weights.
-pub const LUMINANCE: [f64; 3] = [0.2126, 0.7152, 0.0722];
+/// Rec. 709 luminance weights (linear RGB), core's. `view.wgsl` accumulates `Y²` with the same weights.
+pub use lodestone_core::material::colormap::LUMINANCE;
 
 /// A block difference counts as significant from this many standard errors of the truth's block
 /// mean (two-sided, about 5% of blocks without bias for Gaussian noise).

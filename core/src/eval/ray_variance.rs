@@ -26,6 +26,7 @@
 //! measured BRDF's lobes are sampled on the slope nodes rather than integrated.
 
 use crate::eval::{Evaluator, FootprintQuery};
+use crate::material::colormap::LUMINANCE;
 use crate::microfacet::brdf::filtered_specular;
 use crate::microfacet::effective_height::height_moments;
 use crate::microfacet::masking_shadowing::G2;
@@ -63,10 +64,11 @@ impl RayMoments {
 
     /// The variance of the rays' luminance (Rec. 709 weights, as the error maps use), at least 0.
     pub fn luminance_variance(&self) -> f64 {
-        const W: [f64; 3] = [0.2126, 0.7152, 0.0722];
         // Var(Σ w_c L_c) needs the channels' covariances; with one shared integrand they are
         // close to perfectly correlated, so the standard deviations add.
-        let sd: f64 = (0..3).map(|c| W[c] * self.variance()[c].sqrt()).sum();
+        let sd: f64 = (0..3)
+            .map(|c| LUMINANCE[c] * self.variance()[c].sqrt())
+            .sum();
         sd * sd
     }
 }
@@ -185,8 +187,9 @@ mod tests {
         let pred = p.predicted_ray_moments(cfg).luminance_variance();
         let e = p.ground_truth(cfg, rays, 7);
         let n = e.samples as f64;
-        const W: [f64; 3] = [0.2126, 0.7152, 0.0722];
-        let sd: f64 = (0..3).map(|c| W[c] * e.std_error[c] * n.sqrt()).sum();
+        let sd: f64 = (0..3)
+            .map(|c| LUMINANCE[c] * e.std_error[c] * n.sqrt())
+            .sum();
         (pred, sd * sd)
     }
 
@@ -287,17 +290,21 @@ mod tests {
         cov / (va * vb).sqrt()
     }
 
+    /// The presets and (camera elevation, distance) of the image experiments below.
+    const IMAGE_PRESETS: [&str; 4] = [
+        "default",
+        "dirt-in-crevices",
+        "snow-under-sky",
+        "bumpy-specular",
+    ];
+    const IMAGE_CAMERAS: [(f64, f64); 3] = [(60.0, 3.0), (80.0, 3.0), (75.0, 12.0)];
+
     #[test]
     #[ignore]
     fn print_image_allocation_gains() {
-        for name in [
-            "default",
-            "dirt-in-crevices",
-            "snow-under-sky",
-            "bumpy-specular",
-        ] {
+        for name in IMAGE_PRESETS {
             let p = Evaluator::new(&preset(name)).unwrap();
-            for (elev, dist) in [(60.0, 3.0), (80.0, 3.0), (75.0, 12.0)] {
+            for (elev, dist) in IMAGE_CAMERAS {
                 let camera = crate::scene::camera::Camera {
                     elevation_deg: elev,
                     distance: dist,
@@ -388,16 +395,10 @@ mod tests {
     fn print_sampling_plan_gains() {
         use crate::eval::sampling_plan::SamplingPlan;
         const REF: usize = 2000;
-        const Y: [f64; 3] = [0.2126, 0.7152, 0.0722];
-        let lum = |v: [f64; 3]| (0..3).map(|c| Y[c] * v[c]).sum::<f64>();
-        for name in [
-            "default",
-            "dirt-in-crevices",
-            "snow-under-sky",
-            "bumpy-specular",
-        ] {
+        let lum = |v: [f64; 3]| (0..3).map(|c| LUMINANCE[c] * v[c]).sum::<f64>();
+        for name in IMAGE_PRESETS {
             let p = Evaluator::new(&preset(name)).unwrap();
-            for (elev, dist) in [(60.0, 3.0), (80.0, 3.0), (75.0, 12.0)] {
+            for (elev, dist) in IMAGE_CAMERAS {
                 let camera = p.surface.clear_camera(&crate::scene::camera::Camera {
                     elevation_deg: elev,
                     distance: dist,

@@ -11,6 +11,10 @@ use crate::material::validation::Problems;
 use crate::math::piecewise::{NCOEF, PiecewisePoly};
 use serde::{Deserialize, Serialize};
 
+/// Rec. 709 luminance weights of linear RGB: `Y = Σ LUMINANCE[c]·rgb[c]` (the error maps' and
+/// the truth's noise estimates; `view.wgsl` accumulates `Y²` with the same weights).
+pub const LUMINANCE: [f64; 3] = [0.2126, 0.7152, 0.0722];
+
 /// How colours are interpolated between stops.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
 pub enum Interpolation {
