@@ -52,18 +52,10 @@ impl Evaluator {
         frame: &DMat3,
         mixture: bool,
     ) -> [f64; 3] {
-        let loc = self.footprint_stats(cfg);
-        let nbar = normal_of(loc.stats.slope_mean);
-        let (t, b) = basis(nbar);
-        let to_local = |w: DVec3| DVec3::new(w.dot(t), w.dot(b), w.dot(nbar));
         if cfg.wo.z <= 0.0 {
             return [0.0; 3];
         }
-        // The footprint's resolved slope can tilt its mean plane away from a grazing view the
-        // ray still meets (image drivers at the horizon): the view then grazes the mean plane,
-        // kept just above its horizon so that the result is continuous across the tilt instead
-        // of black ([`above_horizon`]).
-        let (wo, wi) = (above_horizon(to_local(cfg.wo)), to_local(cfg.wi));
+        let (loc, wo, wi) = self.footprint_frame(cfg);
         if mixture {
             return self.filtered_bins(&loc, cfg, (wo, wi), sun_visible, frame);
         }
@@ -107,6 +99,22 @@ impl Evaluator {
 }
 
 impl Evaluator {
+    /// The footprint's statistics and ωo, ωi in the frame of its mean normal n̄ (tangent frame
+    /// [`basis`]). The footprint's resolved slope can tilt its mean plane away from a grazing view
+    /// the ray still meets (image drivers at the horizon): the view then grazes the mean plane,
+    /// kept just above its horizon so that the result is continuous across the tilt instead of
+    /// black ([`above_horizon`]).
+    pub(super) fn footprint_frame(
+        &self,
+        cfg: &FootprintQuery,
+    ) -> (crate::eval::query::FootprintStats, DVec3, DVec3) {
+        let loc = self.footprint_stats(cfg);
+        let nbar = normal_of(loc.stats.slope_mean);
+        let (t, b) = basis(nbar);
+        let to_local = |w: DVec3| DVec3::new(w.dot(t), w.dot(b), w.dot(nbar));
+        (loc, above_horizon(to_local(cfg.wo)), to_local(cfg.wi))
+    }
+
     /// The noise's exact unresolved slope density over the Gaussian the lobe assumes, at the half
     /// vector's slope relative to the footprint's mean ([`sinusoid_density_ratio`], with the base
     /// roughness as the added Gaussian): 1 for image drivers, transfer curves (their slopes are

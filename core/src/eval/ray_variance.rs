@@ -30,10 +30,8 @@ use crate::material::colormap::LUMINANCE;
 use crate::microfacet::brdf::filtered_specular;
 use crate::microfacet::effective_height::height_moments;
 use crate::microfacet::masking_shadowing::G2;
-use crate::microfacet::slopes::normal_of;
 use crate::microfacet::visible_slopes::visible_slope_nodes;
-use crate::scene::direction::basis;
-use glam::{DMat3, DVec3};
+use glam::DMat3;
 use std::f64::consts::PI;
 
 /// Three-point Gauss–Hermite rule for N(0, 1): nodes `0, ±√3`, weights `2/3, 1/6`.
@@ -81,14 +79,7 @@ impl Evaluator {
             return RayMoments::default();
         }
         let frame = DMat3::IDENTITY;
-        let loc = self.footprint_stats(cfg);
-        let nbar = normal_of(loc.stats.slope_mean);
-        let (t, b) = basis(nbar);
-        let to_local = |w: DVec3| DVec3::new(w.dot(t), w.dot(b), w.dot(nbar));
-        let (wo, wi) = (
-            crate::eval::filtered::above_horizon(to_local(cfg.wo)),
-            to_local(cfg.wi),
-        );
+        let (loc, wo, wi) = self.footprint_frame(cfg);
         let sigma = loc.stats.slope_cov;
         let f = &self.material.filtering;
         let ms = G2::from_directions(wo, wi, &sigma, f.correlation);
@@ -180,7 +171,7 @@ mod tests {
     use crate::driver::footprint::Footprint;
     use crate::eval::test_materials::preset;
     use crate::scene::direction::direction;
-    use glam::DVec2;
+    use glam::{DVec2, DVec3};
 
     /// (predicted, measured) luminance variance of one ray, and the truth's rays.
     fn pair(p: &Evaluator, cfg: &FootprintQuery, rays: usize) -> (f64, f64) {
