@@ -64,9 +64,8 @@ impl RayMoments {
     pub fn luminance_variance(&self) -> f64 {
         // Var(Σ w_c L_c) needs the channels' covariances; with one shared integrand they are
         // close to perfectly correlated, so the standard deviations add.
-        let sd: f64 = (0..3)
-            .map(|c| LUMINANCE[c] * self.variance()[c].sqrt())
-            .sum();
+        let var = self.variance();
+        let sd: f64 = (0..3).map(|c| LUMINANCE[c] * var[c].sqrt()).sum();
         sd * sd
     }
 }
