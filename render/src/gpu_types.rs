@@ -79,7 +79,9 @@ gpu_struct! {
         pixel_sigma: f32 => "f32",
         /// Camera forward axis (unit).
         forward: [f32; 3] => "vec3<f32>",
-        /// Ground-truth frame index (low-discrepancy sequence position); 0 for analytic modes.
+        /// Ground-truth pass index: 0 starts afresh (the pass overwrites the sums), any other
+        /// value adds to them (each pixel's next ray is its own count's position in the
+        /// low-discrepancy sequence); 0 for analytic modes.
         frame: u32 => "u32",
         /// Unit direction toward the directional light (world).
         light: [f32; 3] => "vec3<f32>",
@@ -93,6 +95,19 @@ gpu_struct! {
         shape: u32 => "u32",
         /// Cylinder radius R (world units; unused for the plane).
         radius: f32 => "f32",
+        /// Ground truth over a list (an adaptive plan, `Renderer::draw_planned`): how many
+        /// entries (phase 0) or runs (phase 1) of the `order` buffer this pass reads; 0 traces
+        /// every pixel, one ray each.
+        list_len: u32 => "u32",
+        /// A listed pass's phase: 0 traces the entries into `scratch`, 1 adds each run to its
+        /// pixel, 2 and 3 trace again, alone in their SIMD batch, the entries (2) or this frame's
+        /// pixels (3) whose loops the adapter cut.
+        phase: u32 => "u32",
+        /// Where the runs start in the `order` buffer (entries).
+        runs_at: u32 => "u32",
+        /// 1: a ray whose loops were cut is marked for phase 2 or 3 instead of kept (software
+        /// adapters: `GpuContext::is_software`); 0: it is kept and counted.
+        retry_cut: u32 => "u32",
     }
 }
 

@@ -6,6 +6,7 @@
 //! to linear f32 and 8-bit sRGB, and error heat maps (against the truth with its own noise taken
 //! out: `truth_noise`).
 
+pub mod adaptive_truth;
 pub mod compute;
 pub mod error_map;
 pub mod export;

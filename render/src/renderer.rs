@@ -61,6 +61,10 @@ pub enum RenderError {
     },
 }
 
+/// The most ground-truth rays one chunk of [`Renderer::draw_planned`] traces (its scratch buffer
+/// holds 16 bytes a ray: 4 MiB), and the most rays one call adds to a pixel.
+pub const PLANNED_CHUNK: u32 = 1 << 18;
+
 /// Bytes per pixel of a view target's accumulation buffer (linear RGB + sample count, f32).
 pub const BYTES_PER_PIXEL: u64 = 16;
 
@@ -189,8 +193,59 @@ pub struct ViewTarget {
     accum: wgpu::Buffer,
     moments: wgpu::Buffer,
     view: wgpu::Buffer,
-    /// Ground-truth rays per pixel accumulated so far.
+    /// The ray entries and pixel runs of [`Renderer::draw_planned`] (binding 5; 8 bytes each,
+    /// grown on first use).
+    order: wgpu::Buffer,
+    /// Their rays' colours (binding 6; 16 bytes an entry).
+    scratch: wgpu::Buffer,
+    /// The pixels or rays whose march had a loop cut by the adapter (binding 7, one u32).
+    cut: wgpu::Buffer,
+    /// Ground-truth rays per pixel accumulated so far (the most any pixel has, after
+    /// [`Renderer::draw_planned`]).
     pub samples: u32,
+    /// Rays per pixel after [`Renderer::draw_planned`]; `None` after [`Renderer::draw`].
+    planned: Option<Vec<u32>>,
+}
+
+/// Map a finished `MAP_READ` buffer and copy it out as 32-bit words (waits for the GPU).
+fn map_words(renderer: &Renderer, readback: &wgpu::Buffer) -> Result<Vec<u32>, RenderError> {
+    let slice = readback.slice(..);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    renderer
+        .ctx
+        .device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| RenderError::Readback(e.to_string()))?;
+    match rx.recv() {
+        Ok(Ok(())) => {}
+        Ok(Err(e)) => return Err(RenderError::Readback(e.to_string())),
+        Err(e) => return Err(RenderError::Readback(e.to_string())),
+    }
+    let view = slice
+        .get_mapped_range()
+        .map_err(|e| RenderError::Readback(format!("{e:?}")))?;
+    Ok(bytemuck::cast_slice(&view).to_vec())
+}
+
+/// The `order` (8 bytes an entry) and `scratch` (16 bytes an entry) buffers of a planned ground
+/// truth for `entries` entries.
+fn plan_buffers(device: &wgpu::Device, entries: usize) -> (wgpu::Buffer, wgpu::Buffer) {
+    let make = |label, bytes: u64, usage| {
+        device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: bytes,
+            usage: wgpu::BufferUsages::STORAGE | usage,
+            mapped_at_creation: false,
+        })
+    };
+    let n = entries.max(1) as u64;
+    (
+        make("plan entries", n * 8, wgpu::BufferUsages::COPY_DST),
+        make("plan rays", n * 16, wgpu::BufferUsages::empty()),
+    )
 }
 
 impl ViewTarget {
@@ -216,13 +271,17 @@ impl ViewTarget {
         let accum = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("accumulation"),
             size: bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let moments = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("truth moments"),
             size: bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let view = device.create_buffer(&wgpu::BufferDescriptor {
@@ -231,19 +290,92 @@ impl ViewTarget {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        let (order, scratch) = plan_buffers(device, 1);
+        let cut = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("cut loops"),
+            size: 16,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         Ok(Self {
             width,
             height,
             accum,
             moments,
             view,
+            order,
+            scratch,
+            cut,
             samples: 0,
+            planned: None,
         })
     }
 
     /// Start accumulating afresh (the next ground-truth frame overwrites instead of adding).
     pub fn reset(&mut self) {
         self.samples = 0;
+        self.planned = None;
+    }
+
+    /// The pixels (analytic modes) or ground-truth rays whose march had a loop cut short since
+    /// the target last started (waits for the GPU). Mesa's software adapters (llvmpipe,
+    /// lavapipe) leave any loop of a shader after 65535 iterations over one SIMD batch of
+    /// invocations, silently; a long march near the horizon can reach that, and its answer is
+    /// then not the march's. Counted rays are still in the image: a count above 0 says how many
+    /// of its values are unreliable. Real GPUs have no such cap: 0 there, bar a march that ran out
+    /// of its 20000 steps.
+    pub fn cut_count(&self, renderer: &Renderer) -> Result<u32, RenderError> {
+        let device = &renderer.ctx.device;
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: 16,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("readback"),
+        });
+        enc.copy_buffer_to_buffer(&self.cut, 0, &readback, 0, 16);
+        renderer.ctx.queue.submit([enc.finish()]);
+        let words = map_words(renderer, &readback)?;
+        Ok(words.first().copied().unwrap_or(0))
+    }
+
+    /// Log a warning when [`cut_count`](Self::cut_count) is above 0 (what `mode` drew here).
+    pub fn warn_if_cut(&self, renderer: &Renderer, mode: ViewMode) {
+        match self.cut_count(renderer) {
+            Ok(0) => {}
+            Ok(n) => {
+                let what = if mode == ViewMode::Truth {
+                    format!("{n} ground-truth rays")
+                } else {
+                    format!("{n} pixels of {mode:?}")
+                };
+                log::warn!(
+                    "{what} ({}×{}) ran into the adapter's loop limit and may be wrong \
+                     (Mesa's software rasterizer stops any shader loop after 65535 iterations; \
+                     `--retry-cut-rays` traces such rays again alone, slowly)",
+                    self.width,
+                    self.height
+                );
+            }
+            Err(e) => log::warn!("could not read the cut-loop count: {e}"),
+        }
+    }
+
+    /// Grow the plan buffers to hold `entries` entries (rays plus runs).
+    fn ensure_plan_buffers(&mut self, renderer: &Renderer, entries: usize) {
+        if self.order.size() < entries as u64 * 8 {
+            (self.order, self.scratch) = plan_buffers(&renderer.ctx.device, entries);
+        }
+    }
+
+    /// Ground-truth rays of each pixel (row-major) after [`Renderer::draw_planned`]; `None` when
+    /// every pixel has [`samples`](Self::samples).
+    pub fn planned_rays(&self) -> Option<&[u32]> {
+        self.planned.as_deref()
     }
 
     /// Size in pixels.
@@ -292,23 +424,8 @@ impl ViewTarget {
         });
         enc.copy_buffer_to_buffer(buffer, 0, &readback, 0, size);
         renderer.ctx.queue.submit([enc.finish()]);
-        let slice = readback.slice(..);
-        let (tx, rx) = std::sync::mpsc::channel();
-        slice.map_async(wgpu::MapMode::Read, move |r| {
-            let _ = tx.send(r);
-        });
-        device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| RenderError::Readback(e.to_string()))?;
-        match rx.recv() {
-            Ok(Ok(())) => {}
-            Ok(Err(e)) => return Err(RenderError::Readback(e.to_string())),
-            Err(e) => return Err(RenderError::Readback(e.to_string())),
-        }
-        let view = slice
-            .get_mapped_range()
-            .map_err(|e| RenderError::Readback(format!("{e:?}")))?;
-        let floats: &[f32] = bytemuck::cast_slice(&view);
+        let words = map_words(renderer, &readback)?;
+        let floats: &[f32] = bytemuck::cast_slice(&words);
         Ok(floats
             .chunks_exact(4)
             .map(|c| [c[0], c[1], c[2], c[3]])
@@ -323,6 +440,9 @@ pub struct Renderer {
     pipelines: Arc<PipelineCache>,
     /// Threads compiling pipelines ahead of use ([`Renderer::prewarm`]); joined on drop.
     prewarming: Mutex<Vec<std::thread::JoinHandle<()>>>,
+    /// Ground-truth rays whose loops a software adapter cut are traced again alone
+    /// ([`Renderer::set_retry_cut`]).
+    retry_cut: bool,
 }
 
 /// One compiled view pipeline per feature set. An entry's `OnceLock` is created under the map's
@@ -975,7 +1095,18 @@ impl Renderer {
             ctx,
             pipelines: Arc::default(),
             prewarming: Mutex::new(Vec::new()),
+            retry_cut: false,
         }
+    }
+
+    /// On a software adapter (Mesa's llvmpipe or lavapipe), trace every ground-truth ray whose
+    /// loops the adapter cut ([`ViewTarget::cut_count`]) again, alone in its SIMD batch, so it
+    /// gets the march's own answer (all but those that need more than 65535 iterations of one
+    /// loop even alone, which stay counted). Off by default: the rays cut are the ones that skim
+    /// the surface near the horizon for thousands of steps, and tracing them alone cost 50× the
+    /// frame at 80° (docs/design.md). Ignored on other adapters, which cut nothing.
+    pub fn set_retry_cut(&mut self, on: bool) {
+        self.retry_cut = on;
     }
 
     /// The pipeline for `features`, compiling it now if needed; returns how long that
@@ -1034,12 +1165,13 @@ impl Renderer {
     ) -> Result<LinearImage, RenderError> {
         let mut target = ViewTarget::new(self, width, height)?;
         self.draw(&mut target, material, scene, mode, samples);
+        target.warn_if_cut(self, mode);
         target.read(self)
     }
 
     /// Draw into a persistent target. Analytic modes overwrite it; ground truth adds `samples` more
-    /// rays per pixel to what the target holds (progressive; low-discrepancy, so any count is unbiased). Call [`ViewTarget::reset`] when the camera, light or material
-    /// changes.
+    /// rays per pixel to what the target holds (progressive; low-discrepancy, so any count is
+    /// unbiased). Call [`ViewTarget::reset`] when the camera, light or material changes.
     pub fn draw(
         &self,
         target: &mut ViewTarget,
@@ -1047,6 +1179,156 @@ impl Renderer {
         scene: &Scene,
         mode: ViewMode,
         samples: u32,
+    ) {
+        let retry = mode == ViewMode::Truth && self.retries_cut();
+        if retry {
+            target.ensure_plan_buffers(self, (target.width * target.height) as usize);
+        }
+        let (pipeline, mut params, bind) = self.view_pass(target, material, scene, mode);
+        target.planned = None;
+        params.retry_cut = u32::from(retry);
+        let frames = if mode == ViewMode::Truth {
+            samples.max(1)
+        } else {
+            1
+        };
+        if mode != ViewMode::Truth || target.samples == 0 {
+            self.clear_cut(target);
+        }
+        for _ in 0..frames {
+            params.frame = if mode == ViewMode::Truth {
+                target.samples
+            } else {
+                0
+            };
+            self.dispatch_view(target, &pipeline, &bind, &params, target.height);
+            if retry {
+                let slots = target.width * target.height;
+                self.retry_cut(target, &pipeline, &bind, &params, 3, slots);
+            }
+            target.samples += u32::from(mode == ViewMode::Truth);
+            // Keep the queue short: long progressive runs otherwise pile up thousands of submissions.
+            if target.samples % 8 == 7 {
+                self.wait();
+            }
+        }
+    }
+
+    /// Ground truth with a ray count per pixel (an adaptive plan, [BSSBH13 Sec. 2.4];
+    /// `lodestone_core::eval::sampling_plan`): bring every pixel `p` to `rays[p]` rays in all
+    /// (row-major; a pixel that has more keeps them, one that is missing from `rays` gets none).
+    /// Only the rays still needed are traced, each by its own invocation (a pixel planned hundreds
+    /// of rays costs what hundreds of pixels of one ray cost, not hundreds of passes), in chunks
+    /// of at most [`PLANNED_CHUNK`] rays: a pass traces the chunk's rays into a scratch buffer, a
+    /// second adds each pixel's rays to its sums in sequence order. Each pixel's rays are its own
+    /// low-discrepancy sequence's next ones, so a pixel brought to n rays holds exactly what
+    /// [`draw`](Self::draw)'s first n give it. A target last drawn by `draw` (or reset) starts
+    /// afresh. Pixels with no ray read 0 (weight 0).
+    pub fn draw_planned(
+        &self,
+        target: &mut ViewTarget,
+        material: &GpuMaterial,
+        scene: &Scene,
+        rays: &[u32],
+    ) {
+        let n = (target.width * target.height) as usize;
+        let mut done = match target.planned.take() {
+            Some(d) if target.samples > 0 => d,
+            _ => {
+                target.samples = 0;
+                vec![0; n]
+            }
+        };
+        let need: Vec<u32> = (0..n)
+            .map(|p| {
+                rays.get(p)
+                    .copied()
+                    .unwrap_or(0)
+                    .saturating_sub(done[p])
+                    .min(PLANNED_CHUNK)
+            })
+            .collect();
+        target.ensure_plan_buffers(self, PLANNED_CHUNK as usize + n);
+        let (pipeline, mut params, bind) = self.view_pass(target, material, scene, ViewMode::Truth);
+        let mut p = 0;
+        while p < n {
+            // The next chunk: whole pixels, at most PLANNED_CHUNK rays.
+            let mut entries: Vec<[u32; 2]> = Vec::new();
+            let mut runs: Vec<[u32; 2]> = Vec::new();
+            while p < n && entries.len() + need[p] as usize <= PLANNED_CHUNK as usize {
+                if need[p] > 0 {
+                    runs.push([entries.len() as u32, need[p]]);
+                    entries.extend((0..need[p]).map(|j| [p as u32, done[p] + j]));
+                }
+                p += 1;
+            }
+            if runs.is_empty() {
+                continue;
+            }
+            let runs_at = entries.len();
+            entries.extend_from_slice(&runs);
+            self.ctx
+                .queue
+                .write_buffer(&target.order, 0, bytemuck::cast_slice(&entries));
+            // A fresh target's first pass overwrites (frame 0); later ones add (frame 1), so
+            // pixels outside this chunk are cleared first.
+            if target.samples == 0 {
+                let mut enc =
+                    self.ctx
+                        .device
+                        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                            label: Some("clear"),
+                        });
+                enc.clear_buffer(&target.accum, 0, None);
+                enc.clear_buffer(&target.moments, 0, None);
+                enc.clear_buffer(&target.cut, 0, None);
+                self.ctx.queue.submit([enc.finish()]);
+                target.samples = 1;
+            }
+            params.frame = 1;
+            params.runs_at = runs_at as u32;
+            params.retry_cut = u32::from(self.retries_cut());
+            params.phase = 0;
+            params.list_len = runs_at as u32;
+            self.dispatch_view(
+                target,
+                &pipeline,
+                &bind,
+                &params,
+                params.list_len.div_ceil(target.width),
+            );
+            if params.retry_cut == 1 {
+                self.retry_cut(target, &pipeline, &bind, &params, 2, runs_at as u32);
+            }
+            params.phase = 1;
+            params.list_len = runs.len() as u32;
+            self.dispatch_view(
+                target,
+                &pipeline,
+                &bind,
+                &params,
+                params.list_len.div_ceil(target.width),
+            );
+            self.wait();
+        }
+        for p in 0..n {
+            done[p] += need[p];
+        }
+        target.samples = target.samples.max(done.iter().copied().max().unwrap_or(0));
+        target.planned = Some(done);
+    }
+
+    /// The pipeline, parameters and bind group of one view pass (`frame` and `list_len` left at 0).
+    fn view_pass(
+        &self,
+        target: &ViewTarget,
+        material: &GpuMaterial,
+        scene: &Scene,
+        mode: ViewMode,
+    ) -> (
+        std::sync::Arc<wgpu::ComputePipeline>,
+        ViewParams,
+        wgpu::BindGroup,
     ) {
         let (width, height) = (target.width, target.height);
         let pipeline = self
@@ -1088,71 +1370,98 @@ impl Renderer {
                 params.radius = radius as f32;
             }
         }
+        let entries = [
+            &material.params,
+            &material.data,
+            &target.accum,
+            &target.view,
+            &target.moments,
+            &target.order,
+            &target.scratch,
+            &target.cut,
+        ];
+        let entries: Vec<wgpu::BindGroupEntry> = entries
+            .iter()
+            .enumerate()
+            .map(|(i, b)| wgpu::BindGroupEntry {
+                binding: i as u32,
+                resource: b.as_entire_binding(),
+            })
+            .collect();
         let bind = self
             .ctx
             .device
             .create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("view"),
                 layout: &pipeline.get_bind_group_layout(0),
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: material.params.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: material.data.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: target.accum.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: target.view.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 4,
-                        resource: target.moments.as_entire_binding(),
-                    },
-                ],
+                entries: &entries,
             });
-        let frames = if mode == ViewMode::Truth {
-            samples.max(1)
-        } else {
-            1
-        };
-        for _ in 0..frames {
-            params.frame = if mode == ViewMode::Truth {
-                target.samples
-            } else {
-                0
-            };
-            self.ctx
-                .queue
-                .write_buffer(&target.view, 0, bytemuck::bytes_of(&params));
-            let mut enc = self
-                .ctx
-                .device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                    label: Some("view"),
-                });
-            {
-                let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("view"),
-                    timestamp_writes: None,
-                });
-                pass.set_pipeline(&pipeline);
-                pass.set_bind_group(0, &bind, &[]);
-                pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
-            }
-            self.ctx.queue.submit([enc.finish()]);
-            target.samples += u32::from(mode == ViewMode::Truth);
-            // Keep the queue short: long progressive runs otherwise pile up thousands of submissions.
-            if target.samples % 8 == 7 {
-                self.wait();
-            }
+        (pipeline, params, bind)
+    }
+
+    /// Whether cut rays are traced again ([`Renderer::set_retry_cut`] on a software adapter).
+    fn retries_cut(&self) -> bool {
+        self.retry_cut && self.ctx.is_software()
+    }
+
+    /// Trace again, alone in its SIMD batch, every ray of the last pass whose loops the adapter cut
+    /// (`phase` 2: the `slots` entries of a planned chunk; 3: the `slots` pixels of a frame).
+    fn retry_cut(
+        &self,
+        target: &ViewTarget,
+        pipeline: &wgpu::ComputePipeline,
+        bind: &wgpu::BindGroup,
+        params: &ViewParams,
+        phase: u32,
+        slots: u32,
+    ) {
+        let mut p = *params;
+        p.phase = phase;
+        p.list_len = slots;
+        let batches_per_row = target.width.div_ceil(8);
+        self.dispatch_view(target, pipeline, bind, &p, slots.div_ceil(batches_per_row));
+    }
+
+    /// Zero the target's count of cut loops.
+    fn clear_cut(&self, target: &ViewTarget) {
+        let mut enc = self
+            .ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("clear"),
+            });
+        enc.clear_buffer(&target.cut, 0, None);
+        self.ctx.queue.submit([enc.finish()]);
+    }
+
+    /// Write `params` and dispatch one view pass over `rows` rows of the target's width.
+    fn dispatch_view(
+        &self,
+        target: &ViewTarget,
+        pipeline: &wgpu::ComputePipeline,
+        bind: &wgpu::BindGroup,
+        params: &ViewParams,
+        rows: u32,
+    ) {
+        self.ctx
+            .queue
+            .write_buffer(&target.view, 0, bytemuck::bytes_of(params));
+        let mut enc = self
+            .ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("view"),
+            });
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("view"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, bind, &[]);
+            pass.dispatch_workgroups(target.width.div_ceil(8), rows.div_ceil(8), 1);
         }
+        self.ctx.queue.submit([enc.finish()]);
     }
 
     /// Block until the GPU has finished all submitted work (for timing).

@@ -156,6 +156,10 @@ const GPU_ONLY: &[(&str, &str, &str)] = &[
     ("scene/surface.wgsl", "field_height", "selects the explicit or level-of-detail surface for the one march"),
     ("view.wgsl", "pcg", "per-pixel random numbers of the progressive ground truth"),
     ("view.wgsl", "view_main", "the compute entry point"),
+    ("view.wgsl", "truth_sample", "one progressive ground-truth ray of a pixel (core: Evaluator::trace_ray)"),
+    ("view.wgsl", "planned_truth", "the adaptive ground truth's trace and sum passes (Renderer::draw_planned)"),
+    ("view.wgsl", "count_cut", "counts pixels or rays whose march loops the adapter cut"),
+    ("bindings.wgsl", "note_cut", "records a loop the adapter cut (Mesa's loop limiter)"),
 ];
 
 /// Functions defined at module scope of a WGSL source.
@@ -393,4 +397,39 @@ fn wgsl_norm_quantile_matches_core_on_the_adapter() {
         "norm_quantile: {} inputs, worst relative error / (1 + κ) {worst:.2e}",
         xs.len()
     );
+}
+
+/// The cut-loop detector (`bindings.wgsl` `note_cut`) on the adapter: a loop that ends short of
+/// its own condition is noticed, and one that runs to its end is not. On Mesa's software
+/// adapters a loop is cut after 65535 iterations; on other adapters nothing is cut and the flag
+/// stays down. Either way the flag says exactly whether the loop ran its course.
+#[test]
+fn loops_the_adapter_cuts_are_noticed() {
+    let Some(ctx) = lodestone_tests::gpu("the cut-loop test") else {
+        return;
+    };
+    let bindings = include_str!("../src/shaders/bindings.wgsl");
+    let detector: String = bindings
+        .split("\n\n")
+        .filter(|b| b.contains("loop_cut"))
+        .collect::<Vec<_>>()
+        .join("\n\n");
+    assert!(detector.contains("fn note_cut"), "{detector}");
+    let lib = format!(
+        "{detector}\nfn run(x: f32) -> f32 {{ let n = u32(x); var c = 0u; var i = 0u; \
+         for (; i < n; i = i + 1u) {{ c = c + 1u; }} note_cut(i < n); \
+         return f32(c) + select(0.0, 0.5, loop_cut); }}"
+    );
+    let n = [1000.0f32, 60000.0, 70000.0, 300000.0];
+    let out = lodestone_render::compute::eval_unary(&ctx, &lib, "run", &n);
+    for (x, y) in n.iter().zip(&out) {
+        let (count, flagged) = (y.floor(), y.fract() > 0.25);
+        assert!(count <= *x, "{x}: {y}");
+        assert_eq!(
+            flagged,
+            count < *x,
+            "{x} iterations: ran {count}, flag {flagged}"
+        );
+    }
+    assert_eq!(out[0], 1000.0);
 }

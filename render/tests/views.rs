@@ -691,6 +691,120 @@ fn truth_moments_are_the_sums_of_squared_rays() {
     }
 }
 
+/// An adaptive ground truth's plan (#18 §1): a pixel brought to n rays by `draw_planned`, in one
+/// call or two, holds exactly the sums of `draw`'s first n rays there (its own low-discrepancy
+/// sequence), and a pixel with no ray reads 0. This camera sees no horizon: on llvmpipe a long
+/// march's result can depend on the rays sharing its SIMD batch (Mesa's gallivm cuts any loop of a
+/// shader after 65535 iterations over the batch; docs/design.md), and the two paths batch rays
+/// differently. [`cut_rays_traced_again_alone_agree_across_paths`] covers the horizon.
+#[test]
+fn planned_truth_gives_each_pixel_its_own_first_rays() {
+    let Some(r) = renderer() else { return };
+    check_planned_against_uniform(&r, 55.0, 40);
+}
+
+/// Near the horizon, with cut rays traced again alone (`Renderer::set_retry_cut`), both paths
+/// give each ray the march's own answer: the planned image equals the uniform one again, and on a
+/// software adapter the same view without the retry has rays counted as cut.
+#[test]
+fn cut_rays_traced_again_alone_agree_across_paths() {
+    let Some(mut r) = renderer() else { return };
+    let software = r.context().is_software();
+    let cut = check_planned_against_uniform(&r, 72.0, 0);
+    r.set_retry_cut(true);
+    let left = check_planned_against_uniform(&r, 72.0, 10);
+    if software {
+        assert!(
+            cut > 0,
+            "no ray cut at the horizon: the test no longer covers the retry"
+        );
+    }
+    assert!(
+        left <= cut,
+        "{left} rays still cut with the retry, {cut} without"
+    );
+}
+
+/// Uniform frames 1..=`frames` against two planned calls (ray counts up to `frames`) on a
+/// 24×16 view of the default preset from `elevation` degrees; returns the rays the uniform
+/// accumulation counted as cut. With `frames` = 0 only counts.
+fn check_planned_against_uniform(r: &Renderer, elevation: f64, frames: u32) -> u32 {
+    let p = Evaluator::new(&preset("default.ron")).unwrap();
+    let scene = Scene {
+        camera: Camera {
+            elevation_deg: elevation,
+            azimuth_deg: 10.0,
+            distance: 3.0,
+            target: [0.3, 0.7],
+            fov_deg: 40.0,
+        },
+        light: direction(40f64.to_radians(), 2.0),
+        shape: Shape::Plane,
+    };
+    let gm = GpuMaterial::new(r.context(), &p, scene.camera.target).expect("fits");
+    let (w, h) = (24u32, 16u32);
+    let n = (w * h) as usize;
+    // Uniform references at every count the plans ask for.
+    let mut uniform = lodestone_render::ViewTarget::new(r, w, h).expect("target");
+    if frames == 0 {
+        r.draw(&mut uniform, &gm, &scene, ViewMode::Truth, 8);
+        return uniform.cut_count(r).expect("readback");
+    }
+    let mut at = vec![];
+    for k in 1..=frames {
+        r.draw(&mut uniform, &gm, &scene, ViewMode::Truth, 1);
+        at.push((
+            uniform.read(r).expect("readback").pixels,
+            uniform.read_moments(r).expect("readback").sum_sq,
+        ));
+        assert_eq!(uniform.samples, k);
+    }
+    let first: Vec<u32> = (0..n as u32).map(|p| (p * 7 + p / w) % 4).collect();
+    let second: Vec<u32> = first
+        .iter()
+        .enumerate()
+        .map(|(p, c)| match p {
+            _ if p % 7 == 0 => frames / 2 + (p as u32 % (frames - frames / 2 + 1)),
+            _ if p % 5 == 0 => *c,
+            _ => c + (p as u32 % 3) + 1,
+        })
+        .map(|c| c.min(frames))
+        .collect();
+    let mut planned = lodestone_render::ViewTarget::new(r, w, h).expect("target");
+    // A target that held something else starts afresh.
+    r.draw(&mut planned, &gm, &scene, ViewMode::Truth, 2);
+    for rays in [&first, &second] {
+        r.draw_planned(&mut planned, &gm, &scene, rays);
+        assert_eq!(planned.planned_rays(), Some(rays.as_slice()));
+        let img = planned.read(r).expect("readback").pixels;
+        let sq = planned.read_moments(r).expect("readback").sum_sq;
+        for p in 0..n {
+            let k = rays[p] as usize;
+            let (want, want_sq) = if k == 0 {
+                ([0.0; 4], [0.0; 4])
+            } else {
+                (at[k - 1].0[p], at[k - 1].1[p])
+            };
+            for c in 0..4 {
+                assert!(
+                    (img[p][c] - want[c]).abs() <= 1e-6 * (1.0 + want[c].abs()),
+                    "pixel {p} ({k} rays) channel {c}: {} vs {}",
+                    img[p][c],
+                    want[c]
+                );
+                assert!((sq[p][c] - want_sq[c]).abs() <= 1e-6 * (1.0 + want_sq[c].abs()));
+            }
+        }
+    }
+    // Not every pixel is the same: the comparison saw the relief's noise.
+    let distinct = (0..n)
+        .filter(|p| second[*p] > 0)
+        .map(|p| at[second[p] as usize - 1].0[p][1].to_bits())
+        .collect::<std::collections::HashSet<_>>();
+    assert!(distinct.len() > n / 2, "{} distinct pixels", distinct.len());
+    uniform.cut_count(r).expect("readback")
+}
+
 /// A measured base BRDF (#18 §2): a MERL table of a coloured BRDF (red and green Lambertian, a
 /// blue Beckmann lobe), on the default preset's colour map and relief. Naive looks the table up at
 /// the filtered normal, filtered and view-independent use its fit, ground truth looks every facet

@@ -17,3 +17,16 @@ const SQRT_2: f32 = 1.4142135;
 @group(0) @binding(0) var<storage, read> params: Params;
 
 @group(0) @binding(1) var<storage, read> data: array<f32>;
+
+// GPU only. Set when a loop of the march stopped before its own condition ended it. Mesa's gallivm
+// (llvmpipe, lavapipe) caps every loop of a shader at 65535 iterations over a whole invocation of
+// its SIMD batch (8 lanes, counted while any lane runs; the count is not reset when an enclosing
+// loop comes round again) and then leaves it silently; a long march's inner loops reach that. The
+// view counts the pixels and rays it touched (view.wgsl `cut_count`) instead of showing a wrong
+// answer as right. Cleared per ray or pixel by the view.
+var<private> loop_cut: bool;
+
+// GPU only: record that a loop was cut (`cut` true).
+fn note_cut(cut: bool) {
+    loop_cut = loop_cut || cut;
+}

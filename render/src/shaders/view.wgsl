@@ -9,6 +9,23 @@
 // beside accum's sums, so the truth's own Monte Carlo noise is known per pixel
 // (render/src/truth_noise.rs). Written by ground truth only.
 @group(0) @binding(4) var<storage, read_write> moments: array<vec4<f32>>;
+// An adaptive ground truth's rays (Renderer::draw_planned), in two passes per chunk. Phase 0: entry
+// i = (pixel, sample) of the first `list_len` is one ray, its colour written to scratch[i]. Phase 1:
+// run i = order[runs_at + i] = (first entry, count) of one pixel, whose entries are consecutive and
+// in sample order, adds them to the pixel's sums (in the order a progressive accumulation adds them).
+// Unread when list_len is 0.
+@group(0) @binding(5) var<storage, read> order: array<vec2<u32>>;
+@group(0) @binding(6) var<storage, read_write> scratch: array<vec4<f32>>;
+// Element 0: the pixels (analytic modes) or rays (ground truth) whose march had a loop cut
+// (bindings.wgsl `loop_cut`) since the target started (ViewTarget::cut_count).
+@group(0) @binding(7) var<storage, read_write> cut_count: array<atomic<u32>>;
+
+// GPU only: count this invocation's pixel or ray when a loop of it was cut.
+fn count_cut() {
+    if (loop_cut) {
+        atomicAdd(&cut_count[0], 1u);
+    }
+}
 
 const PIXEL_SIGMA_DEFAULT: f32 = 0.5;
 
@@ -58,6 +75,10 @@ fn view_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invoc
 //#if noise
     fill_wave_cache(local, 64u);
 //#endif
+    if (view_params.list_len > 0u) {
+        planned_truth(gid.xy);
+        return;
+    }
     if (gid.x >= view_params.width || gid.y >= view_params.height) {
         return;
     }
@@ -70,6 +91,7 @@ fn view_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invoc
             let dx = view_params.right * (2.0 * view_params.tan_half_fov * view_params.aspect / f32(view_params.width));
             let dy = view_params.up * (-2.0 * view_params.tan_half_fov / f32(view_params.height));
             accum[idx] = vec4<f32>(cylinder_pixel(view_params.mode, raw_dir(centre), dx, dy, wi), 1.0);
+            count_cut();
             return;
         }
     } else if (view_params.mode < MODE_TRUTH) {
@@ -82,13 +104,30 @@ fn view_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invoc
             c = analytic_pixel(view_params.mode, view_params.eye, normalize(raw_dir(centre)), wi, fp.cov);
         }
         accum[idx] = vec4<f32>(c, 1.0);
+        count_cut();
         return;
     }
-    // Ground truth, one sample per frame: sample s of the R2 low-discrepancy sequence (fixed-point
-    // golden-ratio generalisation), Cranley–Patterson rotated per pixel, mapped through Box–Muller
-    // onto the Gaussian pixel filter. Every prefix of the sequence is evenly spread, so progressive
-    // images are unbiased at any sample count.
-    let s = view_params.frame;
+    // Ground truth, one ray per frame. Frame 0 starts afresh.
+    let fresh = view_params.frame == 0u;
+    let c = truth_sample(idx, centre, view_params.frame, wi);
+    if (view_params.retry_cut == 1u) {
+        // A cut ray is traced again alone (phase 3) instead of added here.
+        scratch[idx] = vec4<f32>(0.0, 0.0, 0.0, select(0.0, 1.0, loop_cut));
+        if (loop_cut) {
+            return;
+        }
+    }
+    let y = dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
+    accum[idx] = select(accum[idx], vec4<f32>(0.0), fresh) + vec4<f32>(c, 1.0);
+    moments[idx] = select(moments[idx], vec4<f32>(0.0), fresh) + vec4<f32>(c * c, y * y);
+    count_cut();
+}
+
+// One ground-truth ray of pixel idx (centre in pixels): sample s of the R2 low-discrepancy sequence
+// (fixed-point golden-ratio generalisation), Cranley–Patterson rotated per pixel, mapped through
+// Box–Muller onto the Gaussian pixel filter. Every prefix of the sequence is evenly spread, so
+// progressive images are unbiased at any sample count.
+fn truth_sample(idx: u32, centre: vec2<f32>, s: u32, wi: vec3<f32>) -> vec3<f32> {
     let r1 = s * 3242174889u + pcg(idx * 2u + 1u);
     let r2 = s * 2447445413u + pcg(idx * 2u + 2u);
     let u1 = (f32(r1 >> 8u) + 0.5) * (1.0 / 16777216.0);
@@ -96,19 +135,69 @@ fn view_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invoc
     let rad = sqrt(-2.0 * log(u1)) * view_params.pixel_sigma;
     let off = vec2<f32>(rad * cos(TAU * u2), rad * sin(TAU * u2));
     let d = normalize(raw_dir(centre + off));
-    var c: vec3<f32>;
 //#if curved
     if (view_params.shape == SHAPE_CYLINDER) {
-        c = cylinder_trace_ray(view_params.eye, d, wi);
-    } else {
-        c = trace_ray(view_params.eye, d, wi);
+        return cylinder_trace_ray(view_params.eye, d, wi);
     }
-//#else
-    c = trace_ray(view_params.eye, d, wi);
 //#endif
-    let prev = select(vec4<f32>(0.0), accum[idx], s > 0u);
-    accum[idx] = prev + vec4<f32>(c, 1.0);
-    let y = dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
-    let prev2 = select(vec4<f32>(0.0), moments[idx], s > 0u);
-    moments[idx] = prev2 + vec4<f32>(c * c, y * y);
+    return trace_ray(view_params.eye, d, wi);
+}
+
+// The listed passes (Renderer::draw_planned, and the retry of Renderer::draw): phase 0 traces
+// entry i into scratch[i]; phase 1 adds run i's rays to its pixel (frame 0 starts the pixel
+// afresh); phases 2 (entries) and 3 (pixels) trace again the rays phase 0 or a frame marked cut
+// (scratch w = 1), one per SIMD batch of eight lanes (`gid.x` a multiple of 8: the other seven
+// lanes idle), so no other lane's loops count against the adapter's loop limit.
+fn planned_truth(gid: vec2<u32>) {
+    if (view_params.phase >= 2u) {
+        let k = gid.y * ((view_params.width + 7u) / 8u) + gid.x / 8u;
+        if (gid.x % 8u != 0u || k >= view_params.list_len || scratch[k].w == 0.0) {
+            return;
+        }
+        loop_cut = false;
+        if (view_params.phase == 2u) {
+            let e = order[k];
+            let centre = vec2<f32>(f32(e.x % view_params.width) + 0.5, f32(e.x / view_params.width) + 0.5);
+            scratch[k] = vec4<f32>(truth_sample(e.x, centre, e.y, view_params.light), 0.0);
+        } else {
+            let centre = vec2<f32>(f32(k % view_params.width) + 0.5, f32(k / view_params.width) + 0.5);
+            let c = truth_sample(k, centre, view_params.frame, view_params.light);
+            let fresh = view_params.frame == 0u;
+            let y = dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
+            accum[k] = select(accum[k], vec4<f32>(0.0), fresh) + vec4<f32>(c, 1.0);
+            moments[k] = select(moments[k], vec4<f32>(0.0), fresh) + vec4<f32>(c * c, y * y);
+            scratch[k] = vec4<f32>(0.0);
+        }
+        // Still cut: counted as unreliable.
+        count_cut();
+        return;
+    }
+    let i = gid.y * view_params.width + gid.x;
+    if (i >= view_params.list_len) {
+        return;
+    }
+    if (view_params.phase == 0u) {
+        let e = order[i];
+        let centre = vec2<f32>(f32(e.x % view_params.width) + 0.5, f32(e.x / view_params.width) + 0.5);
+        let c = truth_sample(e.x, centre, e.y, view_params.light);
+        let retry = loop_cut && view_params.retry_cut == 1u;
+        scratch[i] = vec4<f32>(c, select(0.0, 1.0, retry));
+        if (!retry) {
+            count_cut();
+        }
+        return;
+    }
+    let run = order[view_params.runs_at + i];
+    let idx = order[run.x].x;
+    let fresh = view_params.frame == 0u;
+    var acc = select(accum[idx], vec4<f32>(0.0), fresh);
+    var acc2 = select(moments[idx], vec4<f32>(0.0), fresh);
+    for (var j = 0u; j < run.y; j = j + 1u) {
+        let c = scratch[run.x + j].xyz;
+        acc = acc + vec4<f32>(c, 1.0);
+        let y = dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
+        acc2 = acc2 + vec4<f32>(c * c, y * y);
+    }
+    accum[idx] = acc;
+    moments[idx] = acc2;
 }

@@ -21,6 +21,7 @@ fn value_and_gradient(x: vec2<f32>) -> vec3<f32> {
     for (; i < params.wave_count; i = i + 1u) {
         s = s + wave_term(i, x);
     }
+    note_cut(i < params.wave_count);
     return s;
 //#else
     return vec3<f32>(0.0);

@@ -97,6 +97,7 @@ fn lod_mean(x: vec2<f32>) -> f32 {
     for (; i < lod_count; i = i + 1u) {
         m = m + lod_term(i, x);
     }
+    note_cut(i < lod_count);
 //#endif
     return m;
 }

@@ -39,13 +39,17 @@ fn grid_range(lo: vec2<f32>, hi: vec2<f32>) -> vec3<f32> {
     let base = params.grid_offset + 2u * ((4u * (params.grid_n * params.grid_n - size * size)) / 3u);
     var a = 3.0e38;
     var b = -3.0e38;
-    for (var j = j0; j <= j1; j = j + 1u) {
-        for (var i = i0; i <= i1; i = i + 1u) {
+    var j = j0;
+    for (; j <= j1; j = j + 1u) {
+        var i = i0;
+        for (; i <= i1; i = i + 1u) {
             let c = base + 2u * (j * size + i);
             a = min(a, data[c]);
             b = max(b, data[c + 1u]);
         }
+        note_cut(i <= i1);
     }
+    note_cut(j <= j1);
     return vec3<f32>(a, b, 1.0);
 }
 

@@ -36,7 +36,9 @@ fn octave_grid_skip(o: vec3<f32>, d: vec3<f32>, t: f32, len: ptr<function, f32>,
     let cell = params.grid_cell;
     var best = vec3<f32>(t, 0.0, 0.0);
     var l = max(*len, 2.0 * cell);
-    for (var i = 0u; i < GRID_TRIES; i = i + 1u) {
+    var i = 0u;
+    var left = false;
+    for (; i < GRID_TRIES; i = i + 1u) {
         let t1 = best.x + l;
         let g = octave_grid_gap(o + d * best.x, o + d * t1, lod, sf);
         if (g.y > 0.0 && g.x > 0.0) {
@@ -44,11 +46,13 @@ fn octave_grid_skip(o: vec3<f32>, d: vec3<f32>, t: f32, len: ptr<function, f32>,
             l = l * 2.0;
         } else {
             if (l <= cell) {
+                left = true;
                 break;
             }
             l = l * 0.5;
         }
     }
+    note_cut(!left && i < GRID_TRIES);
     *len = l;
     return best;
 }

@@ -47,6 +47,8 @@ fn march_heightfield(o: vec3<f32>, d: vec3<f32>, rate: f32, lod: bool, sf: f32) 
         relaxed = step > safe;
         t = t + step;
     }
+    // 20000 steps, or the loop was cut: the answer is not known.
+    note_cut(true);
     return -1.0;
 }
 

@@ -102,6 +102,7 @@ fn octave_partial(first: u32, end: u32, x: vec2<f32>, dxy: vec2<f32>, lod: bool)
     for (; i < end; i = i + 1u) {
         acc = acc + octave_term(i, x, dxy, lod);
     }
+    note_cut(i < end);
     return acc;
 }
 
@@ -153,11 +154,14 @@ fn octave_local_step(found_in: vec3<f32>, above: f32, f: f32, fd: f32, lip: f32,
         return found;
     }
     var trial = 8.0 * max(select(0.0, found.x, found.z > 0.0), min_step);
-    for (var i = 0u; i < 4u; i = i + 1u) {
+    var i = 0u;
+    var left = false;
+    for (; i < 4u; i = i + 1u) {
         let reach = resid + lip * trial;
         let sg = params.sigma_h * lipschitz_on(f - reach, f + reach, lod);
         let gap = above - sg * resid;
         if (!(gap >= 0.0)) {
+            left = true;
             break;
         }
         var s = octave_step(gap, fd, lip, curv, dz, sg);
@@ -171,10 +175,12 @@ fn octave_local_step(found_in: vec3<f32>, above: f32, f: f32, fd: f32, lip: f32,
             found = vec3<f32>(step, gap, 1.0);
         }
         if (s < trial) {
+            left = true;
             break;
         }
         trial = trial * 8.0;
     }
+    note_cut(!left && i < 4u);
 //#endif
     return found;
 }
@@ -347,7 +353,9 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
         var best_g = 0.0;
         var known = 0.0;
         var deepest = 0u;
-        for (var l = 0u; l < levels; l = l + 1u) {
+        var l = 0u;
+        var left = false;
+        for (; l < levels; l = l + 1u) {
             let e = level_end(l, lod);
             acc = acc + octave_partial(start, e, p.xy, d.xy, lod);
             start = e;
@@ -391,9 +399,11 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
                 }
             }
             if (l >= j && have) {
+                left = true;
                 break;
             }
         }
+        note_cut(!left && l < levels);
         if (!have) {
             return -1.0;
         }
@@ -423,6 +433,8 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
         }
         t = t + max(best_s, min_step);
     }
+    // 20000 steps, or the loop was cut: the answer is not known.
+    note_cut(true);
     return -1.0;
 }
 //#endif
