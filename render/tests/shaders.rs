@@ -157,7 +157,11 @@ const GPU_ONLY: &[(&str, &str, &str)] = &[
     ("view.wgsl", "pcg", "per-pixel random numbers of the progressive ground truth"),
     ("view.wgsl", "view_main", "the compute entry point"),
     ("view.wgsl", "truth_sample", "one progressive ground-truth ray of a pixel (core: Evaluator::trace_ray)"),
-    ("view.wgsl", "planned_truth", "the adaptive ground truth's trace and sum passes (Renderer::draw_planned)"),
+    ("view.wgsl", "listed_ray", "the ray a listed pass traces (Renderer::draw_planned and the cut-ray retry)"),
+    ("view.wgsl", "sum_runs", "adds each pixel's listed rays to its sums (Renderer::draw_planned)"),
+    ("view.wgsl", "analytic_view", "one pixel of an analytic mode (core: Evaluator::plane_pixel, cylinder_pixel)"),
+    ("view.wgsl", "pixel_centre", "a pixel's centre from its index"),
+    ("view.wgsl", "add_ray", "adds one ground-truth ray to a pixel's sums"),
     ("view.wgsl", "count_cut", "counts pixels or rays whose march loops the adapter cut"),
     ("bindings.wgsl", "note_cut", "records a loop the adapter cut (Mesa's loop limiter)"),
 ];

@@ -75,66 +75,105 @@ fn view_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invoc
 //#if noise
     fill_wave_cache(local, 64u);
 //#endif
-    if (view_params.list_len > 0u) {
-        planned_truth(gid.xy);
+    let listed = view_params.list_len > 0u;
+    if (listed && view_params.phase == 1u) {
+        sum_runs(gid.y * view_params.width + gid.x);
         return;
     }
-    if (gid.x >= view_params.width || gid.y >= view_params.height) {
-        return;
-    }
-    let idx = gid.y * view_params.width + gid.x;
-    let centre = vec2<f32>(f32(gid.x) + 0.5, f32(gid.y) + 0.5);
-    let wi = view_params.light;
-//#if curved
-    if (view_params.shape == SHAPE_CYLINDER) {
+    // The ray this invocation traces: (pixel, sample, slot, 1), or w = 0 for none. One call of
+    // truth_sample below serves every path (each call site inlines the whole march).
+    var ray = vec4<u32>(0u);
+    if (listed) {
+        ray = listed_ray(gid.xy);
+    } else {
+        if (gid.x >= view_params.width || gid.y >= view_params.height) {
+            return;
+        }
+        let idx = gid.y * view_params.width + gid.x;
         if (view_params.mode < MODE_TRUTH) {
-            let dx = view_params.right * (2.0 * view_params.tan_half_fov * view_params.aspect / f32(view_params.width));
-            let dy = view_params.up * (-2.0 * view_params.tan_half_fov / f32(view_params.height));
-            accum[idx] = vec4<f32>(cylinder_pixel(view_params.mode, raw_dir(centre), dx, dy, wi), 1.0);
-            count_cut();
+            analytic_view(idx);
             return;
         }
-    } else if (view_params.mode < MODE_TRUTH) {
-//#else
-    if (view_params.mode < MODE_TRUTH) {
-//#endif
-        let fp = plane_footprint(centre);
-        var c = vec3<f32>(0.0);
-        if (fp.hit) {
-            c = analytic_pixel(view_params.mode, view_params.eye, normalize(raw_dir(centre)), wi, fp.cov);
-        }
-        accum[idx] = vec4<f32>(c, 1.0);
-        count_cut();
+        ray = vec4<u32>(idx, view_params.frame, idx, 1u);
+    }
+    if (ray.w == 0u) {
         return;
     }
-    // Ground truth, one ray per frame. Frame 0 starts afresh.
-    let fresh = view_params.frame == 0u;
-    let c = truth_sample(idx, centre, view_params.frame, wi);
-    if (view_params.retry_cut == 1u) {
-        // A cut ray is traced again alone (phase 3) instead of added here.
-        scratch[idx] = vec4<f32>(0.0, 0.0, 0.0, select(0.0, 1.0, loop_cut));
-        if (loop_cut) {
+    let c = truth_sample(ray.x, ray.y, view_params.light);
+    let slot = ray.z;
+    if (!listed) {
+        // Ground truth, one ray per frame. A cut ray is traced again alone (phase 3) instead of
+        // added here.
+        if (view_params.retry_cut == 1u) {
+            scratch[slot] = vec4<f32>(0.0, 0.0, 0.0, select(0.0, 1.0, loop_cut));
+            if (loop_cut) {
+                return;
+            }
+        }
+        add_ray(ray.x, c);
+    } else if (view_params.phase == 0u) {
+        let retry = loop_cut && view_params.retry_cut == 1u;
+        scratch[slot] = vec4<f32>(c, select(0.0, 1.0, retry));
+        if (retry) {
             return;
         }
+    } else if (view_params.phase == 2u) {
+        scratch[slot] = vec4<f32>(c, 0.0);
+    } else {
+        add_ray(ray.x, c);
+        scratch[slot] = vec4<f32>(0.0);
     }
-    let y = dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
-    accum[idx] = select(accum[idx], vec4<f32>(0.0), fresh) + vec4<f32>(c, 1.0);
-    moments[idx] = select(moments[idx], vec4<f32>(0.0), fresh) + vec4<f32>(c * c, y * y);
+    // Still cut (after a retry, or with none): counted as unreliable.
     count_cut();
 }
 
-// One ground-truth ray of pixel idx (centre in pixels): sample s of the R2 low-discrepancy sequence
-// (fixed-point golden-ratio generalisation), Cranley–Patterson rotated per pixel, mapped through
-// Box–Muller onto the Gaussian pixel filter. Every prefix of the sequence is evenly spread, so
-// progressive images are unbiased at any sample count.
-fn truth_sample(idx: u32, centre: vec2<f32>, s: u32, wi: vec3<f32>) -> vec3<f32> {
+// An analytic mode's pixel idx.
+fn analytic_view(idx: u32) {
+    let centre = pixel_centre(idx);
+    let wi = view_params.light;
+//#if curved
+    if (view_params.shape == SHAPE_CYLINDER) {
+        let dx = view_params.right * (2.0 * view_params.tan_half_fov * view_params.aspect / f32(view_params.width));
+        let dy = view_params.up * (-2.0 * view_params.tan_half_fov / f32(view_params.height));
+        accum[idx] = vec4<f32>(cylinder_pixel(view_params.mode, raw_dir(centre), dx, dy, wi), 1.0);
+        count_cut();
+        return;
+    }
+//#endif
+    let fp = plane_footprint(centre);
+    var c = vec3<f32>(0.0);
+    if (fp.hit) {
+        c = analytic_pixel(view_params.mode, view_params.eye, normalize(raw_dir(centre)), wi, fp.cov);
+    }
+    accum[idx] = vec4<f32>(c, 1.0);
+    count_cut();
+}
+
+// The centre of pixel idx, in pixels.
+fn pixel_centre(idx: u32) -> vec2<f32> {
+    return vec2<f32>(f32(idx % view_params.width) + 0.5, f32(idx / view_params.width) + 0.5);
+}
+
+// Add one ground-truth ray's colour to pixel idx's sums (frame 0 starts them afresh).
+fn add_ray(idx: u32, c: vec3<f32>) {
+    let fresh = view_params.frame == 0u;
+    let y = dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
+    accum[idx] = select(accum[idx], vec4<f32>(0.0), fresh) + vec4<f32>(c, 1.0);
+    moments[idx] = select(moments[idx], vec4<f32>(0.0), fresh) + vec4<f32>(c * c, y * y);
+}
+
+// One ground-truth ray of pixel idx: sample s of the R2 low-discrepancy sequence (fixed-point
+// golden-ratio generalisation), Cranley–Patterson rotated per pixel, mapped through Box–Muller
+// onto the Gaussian pixel filter. Every prefix of the sequence is evenly spread, so progressive
+// images are unbiased at any sample count.
+fn truth_sample(idx: u32, s: u32, wi: vec3<f32>) -> vec3<f32> {
     let r1 = s * 3242174889u + pcg(idx * 2u + 1u);
     let r2 = s * 2447445413u + pcg(idx * 2u + 2u);
     let u1 = (f32(r1 >> 8u) + 0.5) * (1.0 / 16777216.0);
     let u2 = (f32(r2 >> 8u) + 0.5) * (1.0 / 16777216.0);
     let rad = sqrt(-2.0 * log(u1)) * view_params.pixel_sigma;
     let off = vec2<f32>(rad * cos(TAU * u2), rad * sin(TAU * u2));
-    let d = normalize(raw_dir(centre + off));
+    let d = normalize(raw_dir(pixel_centre(idx) + off));
 //#if curved
     if (view_params.shape == SHAPE_CYLINDER) {
         return cylinder_trace_ray(view_params.eye, d, wi);
@@ -144,47 +183,33 @@ fn truth_sample(idx: u32, centre: vec2<f32>, s: u32, wi: vec3<f32>) -> vec3<f32>
 }
 
 // The listed passes (Renderer::draw_planned, and the retry of Renderer::draw): phase 0 traces
-// entry i into scratch[i]; phase 1 adds run i's rays to its pixel (frame 0 starts the pixel
-// afresh); phases 2 (entries) and 3 (pixels) trace again the rays phase 0 or a frame marked cut
-// (scratch w = 1), one per SIMD batch of eight lanes (`gid.x` a multiple of 8: the other seven
-// lanes idle), so no other lane's loops count against the adapter's loop limit.
-fn planned_truth(gid: vec2<u32>) {
+// entry i into scratch[i]; phase 1 adds run i's rays to its pixel (sum_runs); phases 2 (entries)
+// and 3 (pixels) trace again the rays phase 0 or a frame marked cut (scratch w = 1), one per SIMD
+// batch of eight lanes (`gid.x` a multiple of 8: the other seven lanes idle), so no other lane's
+// loops count against the adapter's loop limit. Returns (pixel, sample, slot, 1), or w = 0 when
+// this invocation has no ray.
+fn listed_ray(gid: vec2<u32>) -> vec4<u32> {
     if (view_params.phase >= 2u) {
         let k = gid.y * ((view_params.width + 7u) / 8u) + gid.x / 8u;
         if (gid.x % 8u != 0u || k >= view_params.list_len || scratch[k].w == 0.0) {
-            return;
+            return vec4<u32>(0u);
         }
-        loop_cut = false;
         if (view_params.phase == 2u) {
-            let e = order[k];
-            let centre = vec2<f32>(f32(e.x % view_params.width) + 0.5, f32(e.x / view_params.width) + 0.5);
-            scratch[k] = vec4<f32>(truth_sample(e.x, centre, e.y, view_params.light), 0.0);
-        } else {
-            let centre = vec2<f32>(f32(k % view_params.width) + 0.5, f32(k / view_params.width) + 0.5);
-            let c = truth_sample(k, centre, view_params.frame, view_params.light);
-            let fresh = view_params.frame == 0u;
-            let y = dot(c, vec3<f32>(0.2126, 0.7152, 0.0722));
-            accum[k] = select(accum[k], vec4<f32>(0.0), fresh) + vec4<f32>(c, 1.0);
-            moments[k] = select(moments[k], vec4<f32>(0.0), fresh) + vec4<f32>(c * c, y * y);
-            scratch[k] = vec4<f32>(0.0);
+            return vec4<u32>(order[k].x, order[k].y, k, 1u);
         }
-        // Still cut: counted as unreliable.
-        count_cut();
-        return;
+        return vec4<u32>(k, view_params.frame, k, 1u);
     }
     let i = gid.y * view_params.width + gid.x;
     if (i >= view_params.list_len) {
-        return;
+        return vec4<u32>(0u);
     }
-    if (view_params.phase == 0u) {
-        let e = order[i];
-        let centre = vec2<f32>(f32(e.x % view_params.width) + 0.5, f32(e.x / view_params.width) + 0.5);
-        let c = truth_sample(e.x, centre, e.y, view_params.light);
-        let retry = loop_cut && view_params.retry_cut == 1u;
-        scratch[i] = vec4<f32>(c, select(0.0, 1.0, retry));
-        if (!retry) {
-            count_cut();
-        }
+    return vec4<u32>(order[i].x, order[i].y, i, 1u);
+}
+
+// Phase 1: add run i's rays (consecutive entries of one pixel, in sample order) to the pixel's
+// sums, in the order a progressive accumulation adds them (frame 0 starts the pixel afresh).
+fn sum_runs(i: u32) {
+    if (i >= view_params.list_len) {
         return;
     }
     let run = order[view_params.runs_at + i];
