@@ -115,6 +115,11 @@ pub enum Command {
         /// with its own Monte Carlo noise taken out (`error` and `all`; 1 = per pixel).
         #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=256))]
         error_block: u32,
+        /// Trace again, alone, the ground-truth rays whose loops a software adapter (llvmpipe)
+        /// cut short, so they get the march's own answer instead of being counted as unreliable
+        /// (slow near the horizon: those rays skim the relief for thousands of steps).
+        #[arg(long)]
+        retry_cut_rays: bool,
     },
     /// Time each mode's frame on the GPU adapter (medians of repeated frames) over presets × view
     /// angles × distances, against a "flat" reference (the same camera and colour with σ_h = 0: the
@@ -235,6 +240,15 @@ pub enum Command {
         /// How the ray marches step and refine a crossing (the reference stays selectable).
         #[arg(long, value_enum, default_value_t = MarchArg::Fast)]
         march: MarchArg,
+        /// Ray budgets of the adaptive ground truth, rays per pixel on average (comma-separated,
+        /// each 1 to 4096; "0" leaves it out).
+        #[arg(long, default_value = "4,16,64", value_delimiter = ',', value_parser = ray_budget)]
+        adaptive_rpp: Vec<f64>,
+        /// Trace again, alone, the ground-truth rays whose loops a software adapter (llvmpipe)
+        /// cut short, so they get the march's own answer instead of being counted as unreliable
+        /// (slow near the horizon: those rays skim the relief for thousands of steps).
+        #[arg(long)]
+        retry_cut_rays: bool,
     },
     /// Run stiff and extreme cases (grazing angles, σ → 0 and 1e6, anisotropy 1e±6, L to 1e12, step
     /// maps, vertical transfer segments, constant images) through core f64, its f32 mirror and the
@@ -386,6 +400,11 @@ pub fn azimuth(s: &str) -> Result<f64, String> {
 pub fn distance(s: &str) -> Result<f64, String> {
     let (lo, hi) = crate::editor::view_state::DISTANCE_RANGE;
     number_in(s, lo, hi, "the camera distance (world units)")
+}
+
+/// An adaptive ground truth's budget: 0 (none) to 4096 rays per pixel on average.
+pub fn ray_budget(s: &str) -> Result<f64, String> {
+    number_in(s, 0.0, 4096.0, "the ray budget (rays per pixel)")
 }
 
 /// A cylinder radius: 0.01 to 10⁴ world units.

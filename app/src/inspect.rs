@@ -264,6 +264,7 @@ mod tests {
             shape: Shape::Plane,
             march: Default::default(),
             error_block: 8,
+            retry_cut_rays: false,
         }
     }
 

@@ -14,6 +14,7 @@ macro_rules! outln {
     ($($t:tt)*) => { $crate::write_stdout(format_args!($($t)*), true) };
 }
 
+mod adaptive_report;
 mod chart;
 mod cielab;
 mod cli;
@@ -228,6 +229,7 @@ fn run(cli: Cli) -> Result<()> {
             formats,
             march,
             error_block,
+            retry_cut_rays,
         }) => {
             let shape = shape.shape(radius).map_err(UsageError)?;
             check_output(&out, mode == cli::RenderMode::All)?;
@@ -240,6 +242,7 @@ fn run(cli: Cli) -> Result<()> {
                 shape,
                 march: march.march(),
                 error_block,
+                retry_cut_rays,
             };
             render_cmd::render(&preset, view, mode, size, spp, &out, formats)?;
         }
@@ -325,6 +328,7 @@ fn run(cli: Cli) -> Result<()> {
                 shape: shape.shape(2.0).map_err(anyhow::Error::msg)?,
                 march: lodestone_core::scene::march::March::default(),
                 error_block: 8,
+                retry_cut_rays: false,
             };
             let opts = inspect::Options {
                 view,
@@ -350,6 +354,8 @@ fn run(cli: Cli) -> Result<()> {
             zooms,
             repeats,
             march,
+            adaptive_rpp,
+            retry_cut_rays,
         }) => {
             check_output(&out, true)?;
             let opts = report::Options {
@@ -359,12 +365,14 @@ fn run(cli: Cli) -> Result<()> {
                 zooms,
                 repeats,
                 march: march.march(),
+                adaptive: adaptive_rpp.into_iter().filter(|b| *b > 0.0).collect(),
+                retry_cut_rays,
             };
             let rep = report::run(&preset, &opts)?;
             report::write(&rep, &out)?;
             out!("{}", report::markdown(&rep));
             outln!(
-                "wrote report.json, report.md, error_vs_time.svg, error_vs_view.svg to {}",
+                "wrote report.json, report.md and the charts (error_vs_time, error_vs_view, error_vs_rays; SVG and PNG) to {}",
                 out.display()
             );
         }

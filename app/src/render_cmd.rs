@@ -37,6 +37,8 @@ pub struct View {
     /// Side of the pixel blocks on whose means errors against the truth are also measured with
     /// its own noise taken out (`lodestone_render::truth_noise`).
     pub error_block: u32,
+    /// Trace cut ground-truth rays again alone (`Renderer::set_retry_cut`).
+    pub retry_cut_rays: bool,
 }
 
 impl View {
@@ -52,6 +54,7 @@ impl View {
             shape: Shape::Plane,
             march: March::Fast,
             error_block: 8,
+            retry_cut_rays: false,
         }
     }
 
@@ -151,7 +154,8 @@ pub fn render(
 ) -> Result<()> {
     let mut prepared = preset.prepare()?;
     prepared.surface.march = view.march;
-    let r = renderer()?;
+    let mut r = renderer()?;
+    r.set_retry_cut(view.retry_cut_rays);
     let scene = view.scene();
     let gm = GpuMaterial::new(r.context(), &prepared, scene.camera.target)?;
     let draw = |m: ViewMode| r.render(&gm, &scene, m, size, spp);
@@ -160,6 +164,7 @@ pub fn render(
     let draw_truth = || -> Result<(LinearImage, SampleMoments)> {
         let mut t = ViewTarget::new(&r, size.0, size.1)?;
         r.draw(&mut t, &gm, &scene, ViewMode::Truth, spp);
+        t.warn_if_cut(&r, ViewMode::Truth);
         Ok((t.read(&r)?, t.read_moments(&r)?))
     };
     // The block errors of `img` against the truth (None while its noise is unknown).

@@ -17,6 +17,9 @@
 //! * Times are synchronised wall times (submit, then wait for the device), medians of `repeats` runs;
 //!   timestamp queries are not used. On the software adapter they are CPU times.
 
+use crate::adaptive_report::{
+    ADAPTIVE_RPP, AdaptiveResult, STRATEGIES, UniformPoint, rmse_true, uniform_rays_at,
+};
 use crate::chart::{Chart, Series};
 use crate::cielab::delta_e76;
 use crate::preset_io::Resolved;
@@ -27,6 +30,7 @@ use lodestone_core::microfacet::masking_shadowing::Correlation;
 use lodestone_core::scene::camera::Camera;
 use lodestone_core::scene::direction::direction;
 use lodestone_core::scene::shape::Shape;
+use lodestone_render::adaptive_truth::{AdaptiveOptions, render_adaptive};
 use lodestone_render::truth_noise::{BlockErrors, TruthEstimate};
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
@@ -51,6 +55,10 @@ pub struct Options {
     pub repeats: u32,
     /// How every march steps and refines (the fast march, or the reference for comparison).
     pub march: lodestone_core::scene::march::March,
+    /// Ray budgets of the adaptive ground truth (rays per pixel on average; empty: none).
+    pub adaptive: Vec<f64>,
+    /// Trace cut ground-truth rays again alone (`Renderer::set_retry_cut`).
+    pub retry_cut_rays: bool,
 }
 
 impl Default for Options {
@@ -62,6 +70,8 @@ impl Default for Options {
             zooms: vec![1.5, 6.0, 40.0],
             repeats: 5,
             march: lodestone_core::scene::march::March::Fast,
+            adaptive: ADAPTIVE_RPP.to_vec(),
+            retry_cut_rays: false,
         }
     }
 }
@@ -100,8 +110,15 @@ pub struct ConfigResult {
     pub light: String,
     /// RMSE of the reference's own noise (see the module docs).
     pub reference_noise: f64,
+    /// Rays of the reference whose loops the adapter cut (`ViewTarget::cut_count`; 0 on real
+    /// GPUs and with `retry_cut_rays`, bar rays that need more than the limit alone).
+    pub reference_cut_rays: u32,
     /// Every method.
     pub methods: Vec<MethodResult>,
+    /// Uniform ground truth's error against the true image per ray count.
+    pub uniform: Vec<UniformPoint>,
+    /// Adaptive ground truth per strategy and budget.
+    pub adaptive: Vec<AdaptiveResult>,
 }
 
 /// The report.
@@ -204,7 +221,8 @@ pub fn run_with(
 ) -> Result<Report> {
     let ctx = GpuContext::new_headless()?;
     let adapter = ctx.describe();
-    let r = Renderer::new(ctx);
+    let mut r = Renderer::new(ctx);
+    r.set_retry_cut(opts.retry_cut_rays);
     let mut exact = preset.material.clone();
     exact.filtering.height_filter = HeightFilter::Exact;
     exact.filtering.correlation = Correlation::HeightDirection;
@@ -278,6 +296,8 @@ pub fn run_with(
                 }
                 let reference = &truth.last().expect("reference").1;
                 let reference_moments = tgt.read_moments(&r)?;
+                let reference_cut_rays = tgt.cut_count(&r)?;
+                tgt.warn_if_cut(&r, ViewMode::Truth);
                 let reference_est = TruthEstimate::new(reference, &reference_moments)
                     .context("the reference's squared sums do not match its image")?;
                 let beyond_noise = |img: &LinearImage| {
@@ -346,12 +366,37 @@ pub fn run_with(
                         ms: ray_ms * f64::from(*n),
                     });
                 }
+                let uniform: Vec<UniformPoint> = truth
+                    .iter()
+                    .filter(|(n, _)| TRUTH_SPP.contains(n) && *n < ref_spp)
+                    .map(|(n, img)| UniformPoint {
+                        spp: *n,
+                        rmse_true: rmse_true(img, &reference_est, &|_| true),
+                        ms: ray_ms * f64::from(*n),
+                    })
+                    .collect();
+                let adaptive = if opts.adaptive.is_empty() {
+                    Vec::new()
+                } else {
+                    adaptive_truth(
+                        &r,
+                        &p_exact,
+                        &gm_exact,
+                        &scene,
+                        opts,
+                        &reference_est,
+                        &uniform,
+                    )?
+                };
                 let c = ConfigResult {
                     distance,
                     view_deg: view,
                     light: light_name.into(),
                     reference_noise,
+                    reference_cut_rays,
                     methods,
+                    uniform,
+                    adaptive,
                 };
                 progress(done, total, &c);
                 configs.push(c);
@@ -369,6 +414,49 @@ pub fn run_with(
         reference_spp: ref_spp,
         configs,
     })
+}
+
+/// The adaptive ground truth of one configuration at every budget and strategy of `opts`.
+fn adaptive_truth(
+    r: &Renderer,
+    evaluator: &lodestone_core::eval::Evaluator,
+    gm: &GpuMaterial,
+    scene: &Scene,
+    opts: &Options,
+    reference: &TruthEstimate,
+    uniform: &[UniformPoint],
+) -> Result<Vec<AdaptiveResult>> {
+    let t = Instant::now();
+    let prediction = evaluator.predict_truth(&scene.camera, opts.size, scene.light);
+    let predict_ms = t.elapsed().as_secs_f64() * 1e3;
+    let mut out = Vec::new();
+    let mut tgt = ViewTarget::new(r, opts.size.0, opts.size.1)?;
+    for &budget in &opts.adaptive {
+        for (strategy, step) in STRATEGIES {
+            let a_opts = AdaptiveOptions {
+                rays_per_pixel: budget,
+                step,
+                max_rays: opts.reference_spp.max(2) / 2,
+            };
+            // One run, as the uniform truth's milestones: its passes are long enough to time once.
+            let t = Instant::now();
+            let a = render_adaptive(r, &mut tgt, gm, scene, &prediction, a_opts)?;
+            let ms = t.elapsed().as_secs_f64() * 1e3;
+            let err = rmse_true(&a.image, reference, &|p| a.plan.rays[p] > 0);
+            out.push(AdaptiveResult {
+                strategy: strategy.into(),
+                budget,
+                rays_per_pixel: a.rays_per_pixel(),
+                shaded_fraction: a.plan.rays.iter().filter(|r| **r > 0).count() as f64
+                    / a.plan.rays.len().max(1) as f64,
+                rmse_true: err,
+                uniform_rays_equal: uniform_rays_at(uniform, err),
+                ms,
+                predict_ms,
+            });
+        }
+    }
+    Ok(out)
 }
 
 /// The Markdown tables: per zoom, RMSE and mean ΔE of every method per configuration, then the
@@ -433,7 +521,22 @@ pub fn markdown(rep: &Report) -> String {
         }
         let _ = writeln!(s);
     }
+    s.push_str(&crate::adaptive_report::markdown(&adaptive_rows(rep)));
     s
+}
+
+/// Each configuration's name with its uniform and adaptive ground truth.
+fn adaptive_rows(rep: &Report) -> Vec<(String, &[UniformPoint], &[AdaptiveResult])> {
+    rep.configs
+        .iter()
+        .map(|c| {
+            (
+                format!("{}° d {} light {}", c.view_deg, c.distance, c.light),
+                c.uniform.as_slice(),
+                c.adaptive.as_slice(),
+            )
+        })
+        .collect()
 }
 
 /// One chart series: label, colour, points, joined by a line.
@@ -503,10 +606,14 @@ pub fn charts(rep: &Report) -> Vec<(&'static str, Chart, Vec<Series>)> {
         log_x: false,
         log_y: true,
     };
-    vec![
+    let mut charts = vec![
         ("error_vs_time", time_chart, time_series),
         ("error_vs_view", view_chart, series),
-    ]
+    ];
+    if let Some((chart, series)) = crate::adaptive_report::chart(&rep.preset, &adaptive_rows(rep)) {
+        charts.push(("error_vs_rays", chart, series));
+    }
+    charts
 }
 
 /// Write report.json, report.md and the charts error_vs_time and error_vs_view, each as PNG and

@@ -364,6 +364,8 @@ fn report_writes_tables_and_charts() {
         "error_vs_time.png",
         "error_vs_view.png",
         "error_vs_view.svg",
+        "error_vs_rays.png",
+        "error_vs_rays.svg",
     ] {
         assert!(dir.join(f).is_file(), "{f} missing");
     }
@@ -372,6 +374,19 @@ fn report_writes_tables_and_charts() {
     let configs = rep["configs"].as_array().unwrap();
     assert_eq!(configs.len(), 2 * 3);
     for c in configs {
+        // Adaptive ground truth (#18 §1): two strategies at the default budgets 4, 16, 64, each
+        // capped at half the reference's 16 rays a pixel.
+        assert!(c["reference_cut_rays"].as_u64().is_some(), "{c}");
+        let adaptive = c["adaptive"].as_array().unwrap();
+        assert_eq!(adaptive.len(), 2 * 3, "{c}");
+        for a in adaptive {
+            let rays = a["rays_per_pixel"].as_f64().unwrap();
+            assert!(rays > 0.0 && rays <= 8.0 + 1e-9, "{a}");
+            let e = a["rmse_true"].as_f64().unwrap();
+            assert!(e.is_finite() && e >= 0.0, "{a}");
+            assert!(a["ms"].as_f64().unwrap() > 0.0, "{a}");
+        }
+        assert_eq!(c["uniform"].as_array().unwrap().len(), 2, "{c}");
         let methods = c["methods"].as_array().unwrap();
         // Four analytic methods and ground truth at 1 and 4 rays (16 is the reference itself).
         assert_eq!(methods.len(), 6, "{c}");

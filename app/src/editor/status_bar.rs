@@ -45,6 +45,19 @@ impl EditorApp {
                         t += &format!(" ({}/{} spp)", f.samples, self.view.truth_spp);
                     }
                     ui.weak(t);
+                    // Adapter-dependent (llvmpipe only): left out of snapshots like the times.
+                    if f.cut_rays > 0 && !self.deterministic {
+                        ui.colored_label(
+                            ui.visuals().warn_fg_color,
+                            format!("{} truth rays cut", f.cut_rays),
+                        )
+                        .on_hover_text(
+                            "These ground-truth rays skim the relief near the horizon for so many \
+                             steps that the software adapter (Mesa's llvmpipe) stopped their loops \
+                             after 65535 iterations: their pixels may be wrong. \
+                             `lodestone render --retry-cut-rays` traces them again alone.",
+                        );
+                    }
                 }
             }
             if let Some(truth) = self.shown.get(&ViewMode::Truth) {

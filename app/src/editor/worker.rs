@@ -65,6 +65,9 @@ pub struct Frame {
     pub moments: Option<Arc<SampleMoments>>,
     /// GPU time of the pass that produced it (for truth: of the last ray per pixel).
     pub pass_time: Duration,
+    /// Ground-truth rays in it whose loops the adapter cut (`ViewTarget::cut_count`: Mesa's
+    /// loop limit on llvmpipe); 0 for analytic modes.
+    pub cut_rays: u32,
     /// Resolution as a fraction of the full view size.
     pub scale: f32,
 }
@@ -392,6 +395,7 @@ impl State {
                             samples: 0,
                             moments: None,
                             pass_time: dt,
+                            cut_rays: 0,
                             scale,
                         }));
                     }
@@ -447,17 +451,22 @@ impl State {
             let done = target.samples >= req.truth_spp;
             // Read back at most ~8 times a second (and always at the end): readback costs a copy.
             if done || last_sent.elapsed() > Duration::from_millis(120) || target.samples <= 4 {
-                let read = target
-                    .read(&self.renderer)
-                    .and_then(|image| Ok((image, target.read_moments(&self.renderer)?)));
+                let read = target.read(&self.renderer).and_then(|image| {
+                    Ok((
+                        image,
+                        target.read_moments(&self.renderer)?,
+                        target.cut_count(&self.renderer)?,
+                    ))
+                });
                 match read {
-                    Ok((image, moments)) => send(Event::Frame(Frame {
+                    Ok((image, moments, cut_rays)) => send(Event::Frame(Frame {
                         generation: req.generation,
                         mode: ViewMode::Truth,
                         image: Arc::new(image),
                         samples: target.samples,
                         moments: Some(Arc::new(moments)),
                         pass_time: dt,
+                        cut_rays,
                         scale,
                     })),
                     Err(e) => {

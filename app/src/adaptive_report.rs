@@ -1,0 +1,315 @@
+//! The adaptive ground truth's part of `lodestone report` (#18 §1): per configuration, uniform
+//! ground truth and adaptive ground truth ([`lodestone_render::adaptive_truth`]) at several ray
+//! budgets, each as its error against the true image, rays per pixel and time; and the uniform ray
+//! count that reaches the same error (the rays an adaptive plan saves at equal error).
+//!
+//! **Error against the true image.** Every truth here shares the reference's low-discrepancy
+//! sequence: a pixel with n rays holds the first n of the reference's R. For such a prefix,
+//! `E[(x̂_n − x̂_R)²] = σ²(1/n − 1/R)`, so its error against the truth is the error against the
+//! reference plus `σ²/R`; a pixel filled by interpolation is independent of the reference there and
+//! its error against the truth is the error against the reference minus `σ²/R`. `σ²/R` per pixel
+//! comes from the reference's squared sums ([`TruthEstimate`]). Pixels given more than R/2 rays are
+//! capped at R/2 so that every shaded pixel is a prefix.
+
+use crate::chart::{Chart, Series};
+use lodestone_render::LinearImage;
+use lodestone_render::truth_noise::TruthEstimate;
+use serde::Serialize;
+use std::fmt::Write as _;
+
+/// Ray budgets (rays per pixel on average) of the adaptive ground truth, by default.
+pub const ADAPTIVE_RPP: [f64; 3] = [4.0, 16.0, 64.0];
+
+/// The adaptive strategies compared: name and lattice step.
+pub const STRATEGIES: [(&str, usize); 2] = [("ray counts", 1), ("lattice 4, refined", 4)];
+
+/// Uniform ground truth at one ray count.
+#[derive(Clone, Debug, Serialize)]
+pub struct UniformPoint {
+    /// Rays per pixel.
+    pub spp: u32,
+    /// RMSE against the true image (linear RGB; see the module docs).
+    pub rmse_true: f64,
+    /// Time (ms), synchronised wall time.
+    pub ms: f64,
+}
+
+/// Adaptive ground truth at one budget.
+#[derive(Clone, Debug, Serialize)]
+pub struct AdaptiveResult {
+    /// The strategy (see [`STRATEGIES`]).
+    pub strategy: String,
+    /// The budget, rays per pixel.
+    pub budget: f64,
+    /// Rays traced per pixel on average.
+    pub rays_per_pixel: f64,
+    /// Fraction of pixels traced (the rest interpolated).
+    pub shaded_fraction: f64,
+    /// RMSE against the true image (linear RGB; see the module docs).
+    pub rmse_true: f64,
+    /// Uniform rays per pixel that reach `rmse_true` (log–log interpolation of the uniform
+    /// curve, extrapolated as 1/√n beyond its ends).
+    pub uniform_rays_equal: f64,
+    /// GPU passes, readbacks and reconstruction (ms).
+    pub ms: f64,
+    /// The model's prediction on the CPU (ms; shared by every budget of the configuration).
+    pub predict_ms: f64,
+}
+
+impl AdaptiveResult {
+    /// Uniform rays over adaptive rays at equal error.
+    pub fn ray_gain(&self) -> f64 {
+        self.uniform_rays_equal / self.rays_per_pixel.max(1e-12)
+    }
+
+    /// Uniform time over adaptive time (prediction included) at equal error, from the uniform
+    /// curve's time per ray.
+    pub fn time_gain(&self, uniform: &[UniformPoint]) -> f64 {
+        let per_ray = uniform
+            .iter()
+            .map(|u| u.ms / f64::from(u.spp.max(1)))
+            .fold(f64::NAN, f64::min);
+        per_ray * self.uniform_rays_equal / (self.ms + self.predict_ms).max(1e-12)
+    }
+}
+
+/// RMSE of `img` against the true image, from its error against `reference` and the
+/// reference's own noise: `+σ²/R` where `prefix(p)` (the pixel holds the first rays of the
+/// reference's sequence), `−σ²/R` elsewhere; clamped at 0.
+pub fn rmse_true(
+    img: &LinearImage,
+    reference: &TruthEstimate,
+    prefix: &dyn Fn(usize) -> bool,
+) -> f64 {
+    let r = reference.image();
+    let (w, h) = (r.width, r.height);
+    let (mut sum, mut n) = (0.0, 0.0f64);
+    for y in 0..h {
+        for x in 0..w {
+            let p = (y * w + x) as usize;
+            let a = img.rgb(x, y).map(f64::from);
+            let e = reference.pixel(x, y);
+            let sign = if prefix(p) { 1.0 } else { -1.0 };
+            for k in 0..3 {
+                let v = if e.var_mean[k].is_finite() {
+                    e.var_mean[k]
+                } else {
+                    0.0
+                };
+                sum += (a[k] - e.mean[k]).powi(2) + sign * v;
+                n += 1.0;
+            }
+        }
+    }
+    (sum / n.max(1.0)).max(0.0).sqrt()
+}
+
+/// The uniform rays per pixel at which `uniform` (sorted by rays) reaches `error`: log–log
+/// interpolation between the bracketing points, 1/√n extrapolation beyond the ends.
+pub fn uniform_rays_at(uniform: &[UniformPoint], error: f64) -> f64 {
+    let pts: Vec<(f64, f64)> = uniform
+        .iter()
+        .filter(|u| u.rmse_true > 0.0 && u.rmse_true.is_finite())
+        .map(|u| (f64::from(u.spp).ln(), u.rmse_true.ln()))
+        .collect();
+    if pts.is_empty() || !(error > 0.0) {
+        return f64::NAN;
+    }
+    let e = error.ln();
+    for pair in pts.windows(2) {
+        let ((n0, e0), (n1, e1)) = (pair[0], pair[1]);
+        if (e <= e0 && e >= e1) || (e >= e0 && e <= e1) {
+            let t = if e1 != e0 { (e - e0) / (e1 - e0) } else { 0.0 };
+            return (n0 + t * (n1 - n0)).exp();
+        }
+    }
+    // Beyond the curve: error ∝ n^(−1/2) from the nearer end.
+    let (first, last) = (pts[0], pts[pts.len() - 1]);
+    let (n0, e0) = if e > first.1 { first } else { last };
+    (n0 - 2.0 * (e - e0)).exp()
+}
+
+/// Every budget any configuration ran, ascending.
+fn budgets(configs: &[(String, &[UniformPoint], &[AdaptiveResult])]) -> Vec<f64> {
+    let mut b: Vec<f64> = configs
+        .iter()
+        .flat_map(|c| c.2.iter().map(|a| a.budget))
+        .collect();
+    b.sort_by(f64::total_cmp);
+    b.dedup();
+    b
+}
+
+/// The Markdown section: per configuration and budget, the uniform rays at equal error and the
+/// gains; then the averages per strategy and budget.
+pub fn markdown(configs: &[(String, &[UniformPoint], &[AdaptiveResult])]) -> String {
+    let mut s = String::new();
+    if configs.iter().all(|c| c.2.is_empty()) {
+        return s;
+    }
+    let _ = writeln!(
+        s,
+        "## Adaptive ground truth (#18 §1)\n\nRMSE against the true image (the reference's noise \
+         accounted per pixel), rays a pixel on average, the uniform rays a pixel that reach the same \
+         error, and the gains in rays and in time (the model's CPU prediction included).\n"
+    );
+    let _ = writeln!(
+        s,
+        "| configuration | strategy | budget | rays/px | shaded | RMSE | uniform rays at equal RMSE | ray gain | time gain |"
+    );
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
+    for (name, uniform, adaptive) in configs {
+        for a in adaptive.iter() {
+            let _ = writeln!(
+                s,
+                "| {name} | {} | {} | {:.1} | {:.0}% | {:.4} | {:.1} | {:.2} | {:.2} |",
+                a.strategy,
+                a.budget,
+                a.rays_per_pixel,
+                100.0 * a.shaded_fraction,
+                a.rmse_true,
+                a.uniform_rays_equal,
+                a.ray_gain(),
+                a.time_gain(uniform)
+            );
+        }
+    }
+    let _ = writeln!(
+        s,
+        "\nGeometric means over the configurations:\n\n| strategy | budget | ray gain | time gain |\n|---|---|---|---|"
+    );
+    for (strategy, _) in STRATEGIES {
+        for b in budgets(configs) {
+            let (mut rg, mut tg, mut n) = (0.0, 0.0, 0.0);
+            for (_, uniform, adaptive) in configs {
+                for a in adaptive
+                    .iter()
+                    .filter(|a| a.strategy == strategy && a.budget == b)
+                {
+                    let (r, t) = (a.ray_gain(), a.time_gain(uniform));
+                    if r > 0.0 && t > 0.0 && r.is_finite() && t.is_finite() {
+                        rg += r.ln();
+                        tg += t.ln();
+                        n += 1.0;
+                    }
+                }
+            }
+            if n > 0.0 {
+                let _ = writeln!(
+                    s,
+                    "| {strategy} | {b} | {:.2} | {:.2} |",
+                    (rg / n).exp(),
+                    (tg / n).exp()
+                );
+            }
+        }
+    }
+    s.push('\n');
+    s
+}
+
+/// Error against rays per pixel (log–log), averaged over the configurations: the uniform curve
+/// and one curve per strategy.
+pub fn chart(
+    preset: &str,
+    configs: &[(String, &[UniformPoint], &[AdaptiveResult])],
+) -> Option<(Chart, Vec<Series>)> {
+    let n = configs.len() as f64;
+    if configs.iter().all(|c| c.2.is_empty()) {
+        return None;
+    }
+    let mut spps: Vec<u32> = configs
+        .iter()
+        .flat_map(|c| c.1.iter().map(|u| u.spp))
+        .collect();
+    spps.sort_unstable();
+    spps.dedup();
+    let uniform: Vec<(f64, f64)> = spps
+        .iter()
+        .map(|s| {
+            let e = configs
+                .iter()
+                .filter_map(|c| c.1.iter().find(|u| u.spp == *s))
+                .map(|u| u.rmse_true)
+                .sum::<f64>()
+                / n;
+            (f64::from(*s), e)
+        })
+        .collect();
+    let mut series = vec![("uniform".to_owned(), "#555555", uniform, true)];
+    for (i, (strategy, _)) in STRATEGIES.iter().enumerate() {
+        let pts: Vec<(f64, f64)> = budgets(configs)
+            .iter()
+            .map(|b| {
+                let hits: Vec<&AdaptiveResult> = configs
+                    .iter()
+                    .flat_map(|c| c.2.iter())
+                    .filter(|a| a.strategy == *strategy && a.budget == *b)
+                    .collect();
+                let k = hits.len().max(1) as f64;
+                (
+                    hits.iter().map(|a| a.rays_per_pixel).sum::<f64>() / k,
+                    hits.iter().map(|a| a.rmse_true).sum::<f64>() / k,
+                )
+            })
+            .collect();
+        series.push((
+            format!("adaptive, {strategy}"),
+            ["#d62728", "#1f77b4"][i % 2],
+            pts,
+            true,
+        ));
+    }
+    Some((
+        Chart {
+            title: format!("{preset}: ground truth error against rays, uniform and adaptive"),
+            x_label: "rays per pixel (log)".into(),
+            y_label: "RMSE against the true image (log)".into(),
+            log_x: true,
+            log_y: true,
+        },
+        series,
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn curve() -> Vec<UniformPoint> {
+        [1u32, 4, 16, 64]
+            .iter()
+            .map(|n| UniformPoint {
+                spp: *n,
+                rmse_true: 0.2 / f64::from(*n).sqrt(),
+                ms: 2.0 * f64::from(*n),
+            })
+            .collect()
+    }
+
+    /// On an exact 1/√n curve, interpolation and extrapolation both invert it.
+    #[test]
+    fn equal_error_rays_invert_the_uniform_curve() {
+        let u = curve();
+        for n in [0.5, 1.0, 2.0, 10.0, 64.0, 300.0] {
+            let e = 0.2 / f64::sqrt(n);
+            let got = uniform_rays_at(&u, e);
+            assert!((got / n - 1.0).abs() < 1e-9, "{n}: {got}");
+        }
+        assert!(uniform_rays_at(&u, 0.0).is_nan());
+        assert!(uniform_rays_at(&[], 0.1).is_nan());
+        let a = AdaptiveResult {
+            strategy: "x".into(),
+            budget: 4.0,
+            rays_per_pixel: 4.0,
+            shaded_fraction: 1.0,
+            rmse_true: 0.2 / 32f64.sqrt(),
+            uniform_rays_equal: uniform_rays_at(&u, 0.2 / 32f64.sqrt()),
+            ms: 6.0,
+            predict_ms: 2.0,
+        };
+        assert!((a.ray_gain() - 8.0).abs() < 1e-9);
+        // Uniform: 2 ms a ray, 32 rays = 64 ms, against 8 ms.
+        assert!((a.time_gain(&u) - 8.0).abs() < 1e-9);
+    }
+}
