@@ -46,7 +46,9 @@ pub fn ran(test: &str, adapter: &str) {
             .append(true)
             .open(path)
         {
-            let _ = writeln!(f, "{test}\t{adapter}");
+            // One write: `writeln!` writes piece by piece, and tests running in parallel
+            // interleaved their pieces (CI counted lines with no adapter).
+            let _ = f.write_all(format!("{test}\t{adapter}\n").as_bytes());
         }
     }
 }
