@@ -119,3 +119,162 @@ fn luminance(img: &LinearImage) -> Vec<f64> {
         .map(|p| crate::truth_noise::luminance(rgb(img, p)))
         .collect()
 }
+
+/// How many rays the prediction is worth when a pixel's deviation is estimated from its own rays
+/// too ([`pixel_deviations`]): a pixel with `n` rays weighs its sample variance by `n − 1` against
+/// the predicted one's `PRIOR_RAYS`, so two or three rays that happen to agree do not starve it.
+pub const PRIOR_RAYS: f64 = 4.0;
+
+/// Each pixel's deviation of one ray's luminance for allocating the next rays of a progressive
+/// adaptive ground truth: the prediction `predicted` (per pixel, as
+/// [`TruthPrediction::sd`]) pooled with what the pixel's own rays measured so far
+/// (`measured[p] = (n, s²)`, the sample variance of its `n` rays' luminance),
+/// `s_p² = (PRIOR_RAYS·σ̂_p² + (n − 1)·s²)/(PRIOR_RAYS + n − 1)` for `n ≥ 2`, the prediction
+/// alone below. Non-finite or negative inputs count as 0; `measured` shorter than `predicted`
+/// leaves the rest on the prediction.
+pub fn pixel_deviations(predicted: &[f64], measured: &[(u32, f64)]) -> Vec<f64> {
+    let clean = |v: f64| if v.is_finite() && v > 0.0 { v } else { 0.0 };
+    predicted
+        .iter()
+        .enumerate()
+        .map(|(p, &sd)| {
+            let prior = clean(sd).powi(2);
+            match measured.get(p) {
+                Some(&(n, var)) if n >= 2 => {
+                    let k = f64::from(n) - 1.0;
+                    ((PRIOR_RAYS * prior + k * clean(var)) / (PRIOR_RAYS + k)).sqrt()
+                }
+                _ => prior.sqrt(),
+            }
+        })
+        .collect()
+}
+
+/// Ray targets for the next round of a progressive adaptive ground truth: `mean_rays` rays per
+/// pixel on average over the image, in proportion to `deviation + DEFENSIVE·mean(deviation)`
+/// (Neyman allocation [BSSBH13 Sec. 2.4], with the defensive mixture of [`render_adaptive`]),
+/// never fewer than a pixel has (`current`) nor than one, never more than `max_rays` (unless it
+/// has them already). The total is `mean_rays × pixels` rounded, or what the floors force beyond
+/// it; what the caps leave over goes to the others (water filling). Empty input gives an empty
+/// plan; non-finite deviations count as 0.
+pub fn progressive_counts(
+    deviation: &[f64],
+    current: &[u32],
+    mean_rays: f64,
+    max_rays: u32,
+) -> Vec<u32> {
+    let n = deviation.len();
+    if n == 0 {
+        return Vec::new();
+    }
+    let dev: Vec<f64> = deviation
+        .iter()
+        .map(|v| if v.is_finite() && *v > 0.0 { *v } else { 0.0 })
+        .collect();
+    let mean_dev = dev.iter().sum::<f64>() / n as f64;
+    // All deviations 0 (or unknown): uniform.
+    let weight: Vec<f64> = if mean_dev > 0.0 {
+        dev.iter().map(|d| d + DEFENSIVE * mean_dev).collect()
+    } else {
+        vec![1.0; n]
+    };
+    let floor: Vec<f64> = (0..n)
+        .map(|p| f64::from(current.get(p).copied().unwrap_or(0).max(1)))
+        .collect();
+    let cap: Vec<f64> = (0..n)
+        .map(|p| f64::from(max_rays.max(1)).max(floor[p]))
+        .collect();
+    let mean = if mean_rays.is_finite() {
+        mean_rays.max(0.0)
+    } else {
+        0.0
+    };
+    let total = (mean * n as f64).round();
+    let at = |lambda: f64| -> f64 {
+        (0..n)
+            .map(|p| (lambda * weight[p]).clamp(floor[p], cap[p]))
+            .sum()
+    };
+    // Σ clamp(λ w_p) is non-decreasing in λ: bisect for the λ that spends the total.
+    let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+    while at(hi) < total && hi < 1e300 {
+        hi *= 2.0;
+    }
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if at(mid) < total {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    // Round with the error carried along the pixels, so the total stays within one ray.
+    let mut carry = 0.0;
+    (0..n)
+        .map(|p| {
+            let want = (hi * weight[p]).clamp(floor[p], cap[p]) + carry;
+            let r = want.round().clamp(floor[p], cap[p]);
+            carry = want - r;
+            r as u32
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts_follow_the_deviation_and_spend_the_budget() {
+        // Deviations 1 and 3 (mean 2): weights 2 and 4, so 16 rays a pixel on average go 2:4.
+        let dev = [1.0, 3.0, 1.0, 3.0];
+        let c = progressive_counts(&dev, &[0; 4], 16.0, 1000);
+        assert_eq!(c.iter().sum::<u32>(), 64);
+        assert!(c[0].abs_diff(11) <= 1 && c[1].abs_diff(21) <= 1, "{c:?}");
+        // Equal deviations (or none known) are uniform.
+        assert_eq!(progressive_counts(&[0.5; 6], &[0; 6], 4.0, 100), vec![4; 6]);
+        assert_eq!(progressive_counts(&[0.0; 3], &[0; 3], 2.0, 100), vec![2; 3]);
+    }
+
+    #[test]
+    fn counts_respect_floors_and_caps() {
+        // One pixel far noisier than the rest is capped; the rays it cannot take go elsewhere.
+        let mut dev = vec![0.1; 10];
+        dev[3] = 100.0;
+        let c = progressive_counts(&dev, &[0; 10], 8.0, 20);
+        assert_eq!(c[3], 20);
+        assert_eq!(c.iter().sum::<u32>(), 80);
+        assert!(c.iter().all(|&r| r >= 1));
+        // A pixel never loses rays it has, and every pixel gets one.
+        let cur = [9, 0, 0, 0];
+        let c = progressive_counts(&[0.0, 1.0, 1.0, 1.0], &cur, 2.0, 100);
+        assert!(c[0] >= 9 && c.iter().all(|&r| r >= 1), "{c:?}");
+        // The floors may exceed the budget: then they are the plan.
+        assert_eq!(progressive_counts(&[1.0; 2], &[5, 7], 1.0, 100), vec![5, 7]);
+    }
+
+    #[test]
+    fn hostile_inputs_still_give_a_plan() {
+        assert!(progressive_counts(&[], &[], 4.0, 10).is_empty());
+        let c = progressive_counts(&[f64::NAN, f64::INFINITY, -1.0, 1.0], &[], f64::NAN, 0);
+        assert_eq!(c, vec![1; 4]);
+        let c = progressive_counts(&[1.0, 2.0], &[], f64::INFINITY, 1 << 20);
+        assert_eq!(c, vec![1, 1]);
+        let c = progressive_counts(&[1e300, 1e-300], &[], 1e6, u32::MAX);
+        assert!(c.iter().all(|&r| r >= 1));
+    }
+
+    #[test]
+    fn deviations_pool_prediction_and_measurement() {
+        // No rays yet, or one: the prediction.
+        assert_eq!(pixel_deviations(&[0.3, 0.4], &[(1, 9.0)]), vec![0.3, 0.4]);
+        // Many rays: the measurement dominates; PRIOR_RAYS + 1 rays weigh them evenly.
+        let d = pixel_deviations(&[0.0], &[(10_001, 4.0)]);
+        assert!((d[0] - 2.0).abs() < 1e-3, "{d:?}");
+        let d = pixel_deviations(&[1.0], &[(PRIOR_RAYS as u32 + 1, 9.0)]);
+        assert!((d[0] - 5.0_f64.sqrt()).abs() < 1e-12);
+        // Hostile values count as 0.
+        let d = pixel_deviations(&[f64::NAN, -2.0], &[(5, f64::INFINITY), (0, 1.0)]);
+        assert_eq!(d, vec![0.0, 0.0]);
+    }
+}

@@ -1,8 +1,9 @@
 //! The render worker's side of the window: requests for what the views need, frames uploaded as
 //! textures as they arrive, and error heat maps against the ground truth.
 
+use super::truth_maps::{truth_heat, truth_values};
 use super::worker::{Event, Frame, Request};
-use super::{DeviceStatus, EditorApp, ErrorShown, Shown};
+use super::{DeviceStatus, EditorApp, ErrorShown, Shown, TruthHeatShown};
 use lodestone_render::error_map::{error_heat, error_stats, heat_gradient};
 use lodestone_render::truth_noise::{BlockErrors, TruthEstimate};
 use lodestone_render::{LinearImage, ViewMode};
@@ -112,6 +113,45 @@ impl EditorApp {
         }
     }
 
+    /// The truth viewport's noise map, when it shows one, from the latest truth frame.
+    pub(super) fn update_truth_heat(&mut self, ctx: &egui::Context) {
+        let display = self.view.truth_display;
+        let Some(truth) = self.shown.get(&ViewMode::Truth) else {
+            return;
+        };
+        let f = &truth.frame;
+        let from = (f.generation, f.samples, display);
+        if self.truth_heat.as_ref().is_some_and(|h| h.from == from) {
+            return;
+        }
+        let Some(values) = truth_values(f, display) else {
+            self.truth_heat = None;
+            return;
+        };
+        let heat = truth_heat(&values, f.image.width, f.image.height);
+        let img = heat.image.to_srgb8();
+        let color = egui::ColorImage::from_rgba_unmultiplied(
+            [img.width() as usize, img.height() as usize],
+            img.as_raw(),
+        );
+        // Nearest: a ray count is a pixel's own, not a blend of its neighbours'.
+        let opts = egui::TextureOptions::NEAREST;
+        match &mut self.truth_heat {
+            Some(h) => {
+                h.texture.set(color, opts);
+                h.max = heat.max;
+                h.from = from;
+            }
+            None => {
+                self.truth_heat = Some(TruthHeatShown {
+                    texture: ctx.load_texture("truth-heat", color, opts),
+                    max: heat.max,
+                    from,
+                });
+            }
+        }
+    }
+
     /// Send the worker what the views need now, if it changed.
     pub(super) fn request_views(&mut self, ctx: &egui::Context) {
         if self.view_px[0] == 0 || self.view_px[1] == 0 {
@@ -127,6 +167,7 @@ impl EditorApp {
                 && r.modes == modes
                 && r.truth_spp == truth_spp
                 && r.max_scale == self.view.max_scale
+                && r.adaptive_truth == self.view.adaptive_truth
         });
         if same {
             return;
@@ -148,6 +189,7 @@ impl EditorApp {
             modes,
             truth_spp,
             max_scale: self.view.max_scale,
+            adaptive_truth: self.view.adaptive_truth,
         };
         self.worker.request(req.clone());
         self.last_request = Some((self.doc.material.clone(), req));

@@ -4,7 +4,7 @@
 use super::EditorApp;
 use super::commands::Command;
 use super::files::builtin_presets;
-use super::view_state::{self, ViewState};
+use super::view_state::{self, TruthDisplay, ViewState};
 use crate::preset_io;
 
 impl EditorApp {
@@ -116,6 +116,16 @@ impl EditorApp {
                 {
                     self.toggle_ab();
                 }
+                ui.checkbox(&mut self.view.adaptive_truth, "Adaptive ground truth")
+                    .on_hover_text(
+                        "Give each ground-truth pixel its own ray count, in proportion to its predicted and measured noise (BSSBH13 Sec. 2.4), instead of the same count everywhere; the plane only (the cylinder stays uniform)",
+                    );
+                ui.menu_button("Ground truth shows", |ui| {
+                    for d in TruthDisplay::ALL {
+                        ui.radio_value(&mut self.view.truth_display, d, d.label())
+                            .on_hover_text(d.help());
+                    }
+                });
                 ui.checkbox(&mut self.view.show_plots, "Plots");
                 ui.checkbox(&mut self.report.open, "Error against run time report");
                 self.command_button(ui, "Sweep zoom", Command::ToggleSweep);

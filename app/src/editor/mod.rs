@@ -21,6 +21,7 @@ pub mod plots;
 pub mod priority;
 pub mod report_panel;
 mod status_bar;
+mod truth_maps;
 pub mod view_state;
 mod views;
 pub mod worker;
@@ -106,6 +107,15 @@ struct ErrorShown {
     from: (u64, u64, u32, u32, u32),
 }
 
+/// The ground truth's noise map as the truth viewport shows it, uploaded.
+struct TruthHeatShown {
+    texture: egui::TextureHandle,
+    /// The value at the top of its scale.
+    max: f64,
+    /// The truth frame's generation and rays, and the display it shows.
+    from: (u64, u32, view_state::TruthDisplay),
+}
+
 /// A message in the status bar.
 #[derive(Clone, Debug)]
 struct Notice {
@@ -137,6 +147,7 @@ pub struct EditorApp {
     material_error: Option<String>,
     shown: HashMap<ViewMode, Shown>,
     errors: HashMap<ViewMode, ErrorShown>,
+    truth_heat: Option<TruthHeatShown>,
     generation: u64,
     last_request: Option<(Material, Request)>,
     /// Size of one viewport's image in physical pixels (the largest, when they differ).
@@ -222,6 +233,7 @@ impl EditorApp {
             material_error: None,
             shown: HashMap::new(),
             errors: HashMap::new(),
+            truth_heat: None,
             generation: 0,
             last_request: None,
             view_px: [0, 0],
@@ -471,6 +483,7 @@ impl eframe::App for EditorApp {
         egui::CentralPanel::default().show(ui, |ui| self.views_ui(ui));
 
         self.update_errors(&ctx);
+        self.update_truth_heat(&ctx);
         if self.doc.material.validate().is_ok() {
             self.request_views(&ctx);
         }

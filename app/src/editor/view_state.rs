@@ -94,6 +94,61 @@ pub struct ViewState {
     pub show_plots: bool,
     /// The object: the plane or a cylinder.
     pub shape: Shape,
+    /// Ground truth gives each pixel its own ray count from its predicted and measured noise
+    /// (#18 §1; the plane only).
+    pub adaptive_truth: bool,
+    /// What the ground-truth viewport shows: its image or one of its noise maps.
+    pub truth_display: TruthDisplay,
+}
+
+/// What the ground-truth viewport shows.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum TruthDisplay {
+    /// The image.
+    #[default]
+    Image,
+    /// The standard error of each pixel's mean luminance, from its own rays.
+    StandardError,
+    /// One ray's predicted luminance deviation (what adaptive sampling plans with).
+    PredictedDeviation,
+    /// The rays each pixel has.
+    Rays,
+}
+
+impl TruthDisplay {
+    /// Every choice.
+    pub const ALL: [Self; 4] = [
+        Self::Image,
+        Self::StandardError,
+        Self::PredictedDeviation,
+        Self::Rays,
+    ];
+
+    /// Menu and title text.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Image => "image",
+            Self::StandardError => "standard error of the mean",
+            Self::PredictedDeviation => "predicted ray deviation",
+            Self::Rays => "rays per pixel",
+        }
+    }
+
+    /// What it shows, for a tooltip.
+    pub fn help(self) -> &'static str {
+        match self {
+            Self::Image => "The ground-truth image",
+            Self::StandardError => {
+                "√(s²/n) of each pixel's mean luminance, s² the sample variance of its n rays: how far the truth itself may be off"
+            }
+            Self::PredictedDeviation => {
+                "σ̂, one truth ray's luminance deviation predicted from the filtered model (Evaluator::predict_truth: visible colour, slopes, sun visibility, specular second moment); adaptive ground truth plans its rays with it [BSSBH13 Sec. 2.4]"
+            }
+            Self::Rays => {
+                "Rays each pixel has: uniform truth gives every pixel the same; adaptive truth gives them in proportion to σ̂ + ½·mean σ̂, pooled with each pixel's measured deviation"
+            }
+        }
+    }
 }
 
 impl Default for ViewState {
@@ -118,6 +173,8 @@ impl Default for ViewState {
             widths: [1.0 / 3.0, 1.0 / 3.0],
             show_plots: true,
             shape: Shape::Plane,
+            adaptive_truth: false,
+            truth_display: TruthDisplay::Image,
         }
     }
 }

@@ -2,7 +2,7 @@
 //! swipe view), their labels, error heat maps and mouse interaction.
 
 use super::gradient_editor::color32;
-use super::view_state::{DISTANCE_RANGE, Mode};
+use super::view_state::{DISTANCE_RANGE, Mode, TruthDisplay};
 use super::{DeviceStatus, EditorApp};
 use egui::{Color32, Pos2, Rect, Role, Sense, Stroke, Ui, Vec2, WidgetInfo};
 use lodestone_core::scene::camera::Camera;
@@ -338,8 +338,13 @@ impl EditorApp {
         } else {
             None
         };
+        // The truth viewport may show one of its noise maps instead of its image.
+        let truth_map = (rm == ViewMode::Truth && self.view.truth_display != TruthDisplay::Image)
+            .then_some(self.view.truth_display);
         let title = if show_error {
             format!("{} − truth", mode.label())
+        } else if let Some(d) = truth_map {
+            format!("{}: {}", mode.label(), d.label())
         } else {
             mode.label().to_string()
         };
@@ -380,8 +385,11 @@ impl EditorApp {
                 self.toggle_baseline();
             }
         }
+        let heat = truth_map.and(self.truth_heat.as_ref());
         let tex = if show_error {
             self.errors.get(&rm).map(|e| e.texture.id())
+        } else if let Some(h) = heat {
+            Some(h.texture.id())
         } else {
             self.shown.get(&rm).map(|s| s.texture.id())
         };
@@ -411,6 +419,20 @@ impl EditorApp {
                 );
             }
         }
+        if let (Some(d), Some(h)) = (truth_map, heat) {
+            truth_legend(ui, img, d, h.max);
+        } else if let Some(d) = truth_map
+            && tex.is_some()
+        {
+            note(
+                ui,
+                img,
+                &format!(
+                    "no {} for this truth: it needs adaptive ground truth on the plane (View menu)",
+                    d.label()
+                ),
+            );
+        }
         if show_error {
             self.legend(ui, img);
             if let Some(e) = self.errors.get(&rm) {
@@ -422,45 +444,11 @@ impl EditorApp {
 
     /// Heat-scale legend in the corner of an error view.
     fn legend(&self, ui: &Ui, img: Rect) {
-        let g = lodestone_render::error_map::heat_gradient();
-        let r = Rect::from_min_size(
-            Pos2::new(img.left() + 8.0, img.bottom() - 22.0),
-            Vec2::new((img.width() * 0.4).min(160.0), 10.0),
-        );
-        let n = 32;
-        for i in 0..n {
-            let t = i as f64 / f64::from(n - 1);
-            let x0 = r.left() + r.width() * i as f32 / n as f32;
-            ui.painter().rect_filled(
-                Rect::from_min_size(
-                    Pos2::new(x0, r.top()),
-                    Vec2::new(r.width() / n as f32 + 0.5, r.height()),
-                ),
-                0.0,
-                color32(g.sample(t)),
-            );
-        }
-        let font = egui::FontId::proportional(11.0);
-        ui.painter().text(
-            r.left_bottom() + Vec2::new(0.0, 1.0),
-            egui::Align2::LEFT_TOP,
-            "0",
-            font.clone(),
-            Color32::WHITE,
-        );
-        ui.painter().text(
-            r.right_bottom() + Vec2::new(0.0, 1.0),
-            egui::Align2::RIGHT_TOP,
-            format!("{:.3}", self.view.error_scale),
-            font.clone(),
-            Color32::WHITE,
-        );
-        ui.painter().text(
-            r.right_center() + Vec2::new(8.0, 0.0),
-            egui::Align2::LEFT_CENTER,
+        heat_bar(
+            ui,
+            img,
+            &format!("{:.3}", self.view.error_scale),
             "grey: within the truth's noise",
-            font,
-            Color32::from_gray(170),
         );
     }
 
@@ -532,6 +520,80 @@ impl EditorApp {
         );
         self.view.ab = Some(ab);
     }
+}
+
+/// A heat bar from 0 to `max` in the bottom left corner of `img`, titled.
+fn heat_bar(ui: &Ui, img: Rect, max: &str, title: &str) {
+    let g = lodestone_render::error_map::heat_gradient();
+    let r = Rect::from_min_size(
+        Pos2::new(img.left() + 8.0, img.bottom() - 22.0),
+        Vec2::new((img.width() * 0.4).min(160.0), 10.0),
+    );
+    let n = 32;
+    for i in 0..n {
+        let t = i as f64 / f64::from(n - 1);
+        let x0 = r.left() + r.width() * i as f32 / n as f32;
+        ui.painter().rect_filled(
+            Rect::from_min_size(
+                Pos2::new(x0, r.top()),
+                Vec2::new(r.width() / n as f32 + 0.5, r.height()),
+            ),
+            0.0,
+            color32(g.sample(t)),
+        );
+    }
+    let font = egui::FontId::proportional(11.0);
+    ui.painter().text(
+        r.left_bottom() + Vec2::new(0.0, 1.0),
+        egui::Align2::LEFT_TOP,
+        "0",
+        font.clone(),
+        Color32::WHITE,
+    );
+    ui.painter().text(
+        r.right_bottom() + Vec2::new(0.0, 1.0),
+        egui::Align2::RIGHT_TOP,
+        max,
+        font.clone(),
+        Color32::WHITE,
+    );
+    ui.painter().text(
+        r.right_center() + Vec2::new(8.0, 0.0),
+        egui::Align2::LEFT_CENTER,
+        title,
+        font,
+        Color32::from_gray(170),
+    );
+}
+
+/// The legend of the truth viewport's noise map.
+fn truth_legend(ui: &Ui, img: Rect, display: TruthDisplay, max: f64) {
+    let (top, unit) = match display {
+        TruthDisplay::Rays => (format!("{max:.0}"), "rays per pixel"),
+        TruthDisplay::StandardError => (
+            format!("{max:.3}"),
+            "standard error of the mean luminance (grey: under 2 rays)",
+        ),
+        _ => (format!("{max:.3}"), "σ̂ of one ray's luminance"),
+    };
+    heat_bar(ui, img, &top, unit);
+}
+
+/// One line of text over the top left of `img`, on a dark backing.
+fn note(ui: &Ui, img: Rect, text: &str) {
+    let painter = ui.painter_at(img);
+    let galley = painter.layout_no_wrap(
+        text.to_string(),
+        egui::FontId::proportional(12.0),
+        Color32::WHITE,
+    );
+    let at = Pos2::new(img.left() + 4.0, img.top() + 4.0);
+    painter.rect_filled(
+        Rect::from_min_size(at, galley.size()).expand(2.0),
+        2.0,
+        Color32::from_black_alpha(160),
+    );
+    painter.galley(at, galley, Color32::WHITE);
 }
 
 fn px(size: Vec2, ppp: f32) -> [u32; 2] {

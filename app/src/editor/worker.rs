@@ -17,6 +17,8 @@ use lodestone_core::eval::Evaluator;
 use lodestone_core::material::Material;
 use lodestone_core::material::measured::MeasuredBrdf;
 use lodestone_core::math::sh::Sh9;
+use lodestone_core::scene::shape::Shape;
+use lodestone_render::adaptive_truth::{pixel_deviations, progressive_counts};
 use lodestone_render::truth_noise::SampleMoments;
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
@@ -48,6 +50,9 @@ pub struct Request {
     pub truth_spp: u32,
     /// Largest fraction of the full size to render (1 = full resolution).
     pub max_scale: f32,
+    /// Ground truth gives each pixel its own ray count from the predicted and measured noise
+    /// (plane only; the cylinder stays uniform).
+    pub adaptive_truth: bool,
 }
 
 /// A finished image of one mode.
@@ -59,8 +64,14 @@ pub struct Frame {
     pub mode: ViewMode,
     /// Linear RGB (divided by the weight on read).
     pub image: Arc<LinearImage>,
-    /// Ground-truth rays per pixel in it (0 for analytic modes).
+    /// Ground-truth rays per pixel in it, on average over the pixels (0 for analytic modes).
     pub samples: u32,
+    /// An adaptive ground truth's rays per pixel (row-major; `None` for uniform truth and
+    /// analytic modes).
+    pub rays: Option<Arc<Vec<u32>>>,
+    /// The predicted deviation of one truth ray's luminance per pixel that planned them
+    /// (`Evaluator::predict_truth`; `None` where nothing was predicted).
+    pub predicted_sd: Option<Arc<Vec<f32>>>,
     /// Ground truth's per-pixel sums of squared rays (its own noise; `None` for analytic modes).
     pub moments: Option<Arc<SampleMoments>>,
     /// GPU time of the pass that produced it (for truth: of the last ray per pixel).
@@ -393,6 +404,8 @@ impl State {
                             mode,
                             image: Arc::new(image),
                             samples: 0,
+                            rays: None,
+                            predicted_sd: None,
                             moments: None,
                             pass_time: dt,
                             cut_rays: 0,
@@ -416,7 +429,130 @@ impl State {
         if !req.modes.contains(&ViewMode::Truth) || req.truth_spp == 0 {
             return Ok(None);
         }
+        if req.adaptive_truth && req.scene.shape == Shape::Plane {
+            return self.accumulate_adaptive(req, scale, rx, send);
+        }
         self.accumulate_truth(req, scale, rx, send)
+    }
+
+    /// The truth target at `size`, reused when it has that size.
+    fn truth_target(&mut self, size: (u32, u32), send: &dyn Fn(Event)) -> Option<ViewTarget> {
+        match self.truth.take() {
+            Some(t) if t.size() == size => Some(t),
+            _ => match ViewTarget::new(&self.renderer, size.0, size.1) {
+                Ok(t) => Some(t),
+                Err(e) => {
+                    send(Event::RenderError(e.to_string()));
+                    None
+                }
+            },
+        }
+    }
+
+    /// Adaptive ground truth (#18 §1): core predicts each pixel's ray deviation once (on a grid
+    /// of at most [`PREDICT_SIDE`] pixels a side, nearest-upsampled: the allocation needs its
+    /// shape, not its detail), then rounds of doubling budgets (1, 2, 4, … up to `truth_spp` rays
+    /// per pixel on average) give each pixel rays in proportion to its deviation, pooled with
+    /// what its own rays measured ([`pixel_deviations`], [`progressive_counts`]). Each round is
+    /// traced in steps of about one ray per pixel, so a newer request waits no longer than for a
+    /// uniform frame.
+    fn accumulate_adaptive(
+        &mut self,
+        req: &Request,
+        scale: f32,
+        rx: &Receiver<Request>,
+        send: &dyn Fn(Event),
+    ) -> Result<Option<Request>, ()> {
+        let size = Self::size_at(req, scale);
+        let Some(mut target) = self.truth_target(size, send) else {
+            return Ok(None);
+        };
+        target.reset();
+        let Some(prepared) = &self.prepared else {
+            self.truth = Some(target);
+            return Ok(None);
+        };
+        let predicted = predicted_deviation(prepared, &req.scene, size);
+        let predicted_f32 = Arc::new(predicted.iter().map(|v| *v as f32).collect::<Vec<_>>());
+        let n = predicted.len();
+        let spp = req.truth_spp.max(1);
+        let max_rays = spp.saturating_mul(MAX_RAYS_FACTOR).max(16);
+        let mut have = vec![0_u32; n];
+        let mut measured: Vec<(u32, f64)> = Vec::new();
+        let mut last_sent = Instant::now() - Duration::from_secs(1);
+        let mut budget = 1_u32;
+        let result = 'rounds: loop {
+            let goal = progressive_counts(
+                &pixel_deviations(&predicted, &measured),
+                &have,
+                f64::from(budget),
+                max_rays,
+            );
+            let extra: u64 = goal
+                .iter()
+                .zip(&have)
+                .map(|(g, h)| u64::from(g.saturating_sub(*h)))
+                .sum();
+            // Steps of about one ray per pixel each.
+            let steps = extra.div_ceil(n.max(1) as u64).max(1);
+            let start = have.clone();
+            for step in 1..=steps {
+                let Some((_, gm)) = &self.material else {
+                    break 'rounds Ok(None);
+                };
+                for (p, h) in have.iter_mut().enumerate() {
+                    let add = u64::from(goal[p] - start[p]);
+                    *h = start[p] + (add * step).div_ceil(steps) as u32;
+                }
+                let t0 = Instant::now();
+                self.renderer
+                    .draw_planned(&mut target, gm, &req.scene, &have);
+                self.renderer.wait();
+                let dt = t0.elapsed();
+                let done = budget >= spp && step == steps;
+                if step == steps || last_sent.elapsed() > Duration::from_millis(120) {
+                    let read = target.read(&self.renderer).and_then(|image| {
+                        Ok((
+                            image,
+                            target.read_moments(&self.renderer)?,
+                            target.cut_count(&self.renderer)?,
+                        ))
+                    });
+                    match read {
+                        Ok((image, moments, cut_rays)) => {
+                            measured = luminance_variances(&image, &moments);
+                            let total: u64 = have.iter().map(|r| u64::from(*r)).sum();
+                            send(Event::Frame(Frame {
+                                generation: req.generation,
+                                mode: ViewMode::Truth,
+                                image: Arc::new(image),
+                                samples: (total as f64 / n.max(1) as f64).round() as u32,
+                                rays: Some(Arc::new(have.clone())),
+                                predicted_sd: Some(predicted_f32.clone()),
+                                moments: Some(Arc::new(moments)),
+                                pass_time: dt,
+                                cut_rays,
+                                scale,
+                            }));
+                        }
+                        Err(e) => {
+                            send(Event::RenderError(e.to_string()));
+                            break 'rounds Ok(None);
+                        }
+                    }
+                    last_sent = Instant::now();
+                }
+                match Self::newest(rx) {
+                    Err(()) => break 'rounds Err(()),
+                    Ok(Some(newer)) => break 'rounds Ok(Some(newer)),
+                    Ok(None) if done => break 'rounds Ok(None),
+                    Ok(None) => {}
+                }
+            }
+            budget = budget.saturating_mul(2).min(spp);
+        };
+        self.truth = Some(target);
+        result
     }
 
     fn accumulate_truth(
@@ -427,15 +563,8 @@ impl State {
         send: &dyn Fn(Event),
     ) -> Result<Option<Request>, ()> {
         let size = Self::size_at(req, scale);
-        let mut target = match self.truth.take() {
-            Some(t) if t.size() == size => t,
-            _ => match ViewTarget::new(&self.renderer, size.0, size.1) {
-                Ok(t) => t,
-                Err(e) => {
-                    send(Event::RenderError(e.to_string()));
-                    return Ok(None);
-                }
-            },
+        let Some(mut target) = self.truth_target(size, send) else {
+            return Ok(None);
         };
         target.reset();
         let mut last_sent = Instant::now() - Duration::from_secs(1);
@@ -464,6 +593,8 @@ impl State {
                         mode: ViewMode::Truth,
                         image: Arc::new(image),
                         samples: target.samples,
+                        rays: None,
+                        predicted_sd: None,
                         moments: Some(Arc::new(moments)),
                         pass_time: dt,
                         cut_rays,
@@ -486,6 +617,48 @@ impl State {
         self.truth = Some(target);
         result
     }
+}
+
+/// Longest side of the grid on which an adaptive truth's ray deviation is predicted (core, on the
+/// CPU: about 25 µs a pixel here, so at most ~0.2 s on two cores).
+const PREDICT_SIDE: u32 = 96;
+/// An adaptive truth gives no pixel more than this many times the requested rays per pixel.
+const MAX_RAYS_FACTOR: u32 = 8;
+
+/// One truth ray's predicted luminance deviation per pixel of a `size` view of `scene`, predicted
+/// on a grid of at most [`PREDICT_SIDE`] a side and upsampled to nearest.
+fn predicted_deviation(prepared: &Evaluator, scene: &Scene, (w, h): (u32, u32)) -> Vec<f64> {
+    let f = w.max(h).div_ceil(PREDICT_SIDE).max(1);
+    let (sw, sh) = (w.div_ceil(f).max(1), h.div_ceil(f).max(1));
+    let pred = prepared.predict_truth(&scene.camera, (sw, sh), scene.light);
+    let mut out = Vec::with_capacity((w * h) as usize);
+    for y in 0..h {
+        let sy = (u64::from(y) * u64::from(sh) / u64::from(h.max(1))) as usize;
+        for x in 0..w {
+            let sx = (u64::from(x) * u64::from(sw) / u64::from(w.max(1))) as usize;
+            out.push(pred.sd.get(sy * sw as usize + sx).copied().unwrap_or(0.0));
+        }
+    }
+    out
+}
+
+/// Per pixel of a truth image and its squared sums: (rays, sample variance of their luminance).
+fn luminance_variances(image: &LinearImage, moments: &SampleMoments) -> Vec<(u32, f64)> {
+    image
+        .pixels
+        .iter()
+        .zip(&moments.sum_sq)
+        .map(|(p, q)| {
+            let n = f64::from(p[3]);
+            let s = lodestone_render::truth_noise::luminance([0, 1, 2].map(|k| f64::from(p[k])));
+            let var = if n >= 2.0 {
+                ((f64::from(q[3]) - s * s / n) / (n - 1.0)).max(0.0)
+            } else {
+                0.0
+            };
+            (n.max(0.0) as u32, var)
+        })
+        .collect()
 }
 
 /// The hidden editor setting for the march (issue #15: every speed-up is a ratio measured in one
@@ -522,6 +695,7 @@ mod tests {
             modes: vec![ViewMode::Naive, ViewMode::Filtered, ViewMode::Truth],
             truth_spp: spp,
             max_scale: 1.0,
+            adaptive_truth: false,
         }
     }
 
@@ -560,6 +734,71 @@ mod tests {
         }
         assert!(full.contains(&ViewMode::Naive) && full.contains(&ViewMode::Filtered));
         assert_eq!(truth_spp, 3);
+    }
+
+    /// Adaptive ground truth spends the requested rays per pixel on average, gives pixels
+    /// different counts, traces exactly those (each pixel's weight is its count), and gives the
+    /// pixels the prediction calls noisier more rays.
+    #[test]
+    fn adaptive_truth_gives_each_pixel_its_planned_rays() {
+        let w = Worker::spawn(DeviceSource::Headless, || {});
+        match w.wait(Duration::from_secs(60)) {
+            Some(Event::Ready { adapter, .. }) => {
+                lodestone_tests::ran("adaptive_truth_gives_each_pixel_its_planned_rays", &adapter)
+            }
+            Some(Event::NoAdapter(e)) => {
+                lodestone_tests::skip("the adaptive worker test", e);
+                return;
+            }
+            other => panic!("unexpected {other:?}"),
+        }
+        let mut req = request(9, 8);
+        req.adaptive_truth = true;
+        req.modes = vec![ViewMode::Truth];
+        // Grazing, the sun low on the far side: glints and shadows make the noise uneven.
+        req.scene.camera.elevation_deg = 75.0;
+        req.scene.camera.distance = 3.0;
+        req.scene.light = direction(1.2, 0.0);
+        w.request(req);
+        let mut last = None;
+        while let Some(ev) = w.wait(Duration::from_secs(300)) {
+            let Event::Frame(f) = ev else {
+                panic!("unexpected {ev:?}")
+            };
+            if f.mode != ViewMode::Truth {
+                continue;
+            }
+            assert!(f.image.pixels.iter().flatten().all(|v| v.is_finite()));
+            let done = f.samples >= 8;
+            last = Some(f);
+            if done {
+                break;
+            }
+        }
+        let f = last.expect("a truth frame");
+        let rays = f.rays.as_deref().expect("an adaptive truth's ray counts");
+        let sd = f.predicted_sd.as_deref().expect("its prediction");
+        let n = 32 * 24;
+        assert_eq!((rays.len(), sd.len()), (n, n));
+        let total: u32 = rays.iter().sum();
+        assert!(total.abs_diff(8 * n as u32) <= 1, "{total} rays");
+        // Traced as planned: each pixel's weight is its ray count.
+        for (p, r) in f.image.pixels.iter().zip(rays) {
+            assert_eq!(p[3], *r as f32);
+        }
+        let (lo, hi) = (rays.iter().min().unwrap(), rays.iter().max().unwrap());
+        assert!(*lo >= 1 && hi > lo, "rays {lo}..{hi}");
+        // Noisier predicted pixels got more rays on average.
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_by(|a, b| sd[*a].total_cmp(&sd[*b]));
+        let mean =
+            |ix: &[usize]| ix.iter().map(|&p| f64::from(rays[p])).sum::<f64>() / ix.len() as f64;
+        let (quiet, noisy) = (mean(&order[..n / 4]), mean(&order[3 * n / 4..]));
+        eprintln!("rays {lo}..{hi}: quietest quarter {quiet}, noisiest {noisy}");
+        assert!(
+            noisy > 1.5 * quiet,
+            "rays: quietest quarter {quiet}, noisiest {noisy}"
+        );
     }
 
     #[test]

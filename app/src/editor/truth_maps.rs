@@ -1,0 +1,162 @@
+//! The ground truth's noise as heat maps (#18 §1): the standard error of each pixel's mean, the
+//! predicted deviation of one ray that adaptive sampling plans with, and the rays each pixel has.
+
+use super::view_state::TruthDisplay;
+use super::worker::Frame;
+use lodestone_render::LinearImage;
+use lodestone_render::error_map::heat_gradient;
+use lodestone_render::truth_noise::TruthEstimate;
+
+/// A heat map of the truth frame, with the value at the top of its scale.
+pub(super) struct TruthHeat {
+    /// Linear RGB, the frame's size; pixels with no value are dark grey.
+    pub image: LinearImage,
+    /// The largest value shown (the top of the scale).
+    pub max: f64,
+}
+
+/// Dark grey: a pixel whose value is unknown (one ray, or none).
+const UNKNOWN: [f32; 4] = [0.02, 0.02, 0.02, 1.0];
+
+/// Per pixel of `frame` (a ground truth), the value `display` shows; `None` for the image, or
+/// where the frame lacks it (no moments, or no prediction for a uniform truth's deviation).
+pub(super) fn truth_values(frame: &Frame, display: TruthDisplay) -> Option<Vec<Option<f64>>> {
+    let (w, h) = (frame.image.width, frame.image.height);
+    let n = (w * h) as usize;
+    match display {
+        TruthDisplay::Image => None,
+        TruthDisplay::StandardError => {
+            let est = TruthEstimate::new(&frame.image, frame.moments.as_deref()?)?;
+            Some(
+                (0..n as u32)
+                    .map(|i| {
+                        let v = est.pixel(i % w, i / w).var_mean_y;
+                        v.is_finite().then(|| v.max(0.0).sqrt())
+                    })
+                    .collect(),
+            )
+        }
+        TruthDisplay::PredictedDeviation => {
+            let sd = frame.predicted_sd.as_deref()?;
+            (sd.len() == n).then(|| sd.iter().map(|v| Some(f64::from(*v))).collect())
+        }
+        TruthDisplay::Rays => Some(match frame.rays.as_deref() {
+            Some(r) if r.len() == n => r.iter().map(|v| Some(f64::from(*v))).collect(),
+            // Uniform truth: every pixel has the frame's rays (its weight).
+            _ => frame
+                .image
+                .pixels
+                .iter()
+                .map(|p| Some(f64::from(p[3])))
+                .collect(),
+        }),
+    }
+}
+
+/// `values` (row-major, `w × h`) as a heat map scaled to their largest finite value; `None`
+/// entries dark grey. An all-zero map is black with a scale of 0.
+pub(super) fn truth_heat(values: &[Option<f64>], w: u32, h: u32) -> TruthHeat {
+    let max = values
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0_f64, f64::max);
+    let g = heat_gradient();
+    let pixels = values
+        .iter()
+        .map(|v| match v {
+            Some(v) if v.is_finite() => {
+                let t = if max > 0.0 {
+                    (v / max).clamp(0.0, 1.0)
+                } else {
+                    0.0
+                };
+                let c = g.sample(t);
+                [c[0] as f32, c[1] as f32, c[2] as f32, 1.0]
+            }
+            _ => UNKNOWN,
+        })
+        .collect();
+    TruthHeat {
+        image: LinearImage {
+            width: w,
+            height: h,
+            pixels,
+        },
+        max,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lodestone_render::ViewMode;
+    use lodestone_render::truth_noise::SampleMoments;
+    use std::sync::Arc;
+    use std::time::Duration;
+
+    fn frame(pixels: Vec<[f32; 4]>, sum_sq: Vec<[f32; 4]>, rays: Option<Vec<u32>>) -> Frame {
+        let n = pixels.len() as u32;
+        Frame {
+            generation: 1,
+            mode: ViewMode::Truth,
+            image: Arc::new(LinearImage {
+                width: n,
+                height: 1,
+                pixels,
+            }),
+            samples: 2,
+            rays: rays.map(Arc::new),
+            predicted_sd: Some(Arc::new(vec![0.5; n as usize])),
+            moments: Some(Arc::new(SampleMoments {
+                width: n,
+                height: 1,
+                sum_sq,
+            })),
+            pass_time: Duration::ZERO,
+            cut_rays: 0,
+            scale: 1.0,
+        }
+    }
+
+    #[test]
+    fn maps_carry_the_truths_own_numbers() {
+        // Pixel 0: rays 0 and 1 in grey (Y 0 and 1): s² = 0.5, standard error √(0.5/2) = 0.5.
+        // Pixel 1: four equal rays: standard error 0. Pixel 2: one ray: unknown.
+        let f = frame(
+            vec![
+                [1.0, 1.0, 1.0, 2.0],
+                [2.0, 2.0, 2.0, 4.0],
+                [1.0, 1.0, 1.0, 1.0],
+            ],
+            vec![
+                [1.0, 1.0, 1.0, 1.0],
+                [1.0, 1.0, 1.0, 1.0],
+                [1.0, 1.0, 1.0, 1.0],
+            ],
+            Some(vec![2, 4, 1]),
+        );
+        let se = truth_values(&f, TruthDisplay::StandardError).unwrap();
+        assert!((se[0].unwrap() - 0.5).abs() < 1e-6, "{se:?}");
+        assert!(se[1].unwrap().abs() < 1e-6);
+        assert_eq!(se[2], None);
+        let rays = truth_values(&f, TruthDisplay::Rays).unwrap();
+        assert_eq!(rays, vec![Some(2.0), Some(4.0), Some(1.0)]);
+        assert!(truth_values(&f, TruthDisplay::Image).is_none());
+        // A uniform truth's rays are its weights.
+        let u = frame(vec![[0.0, 0.0, 0.0, 3.0]; 2], vec![[0.0; 4]; 2], None);
+        assert_eq!(
+            truth_values(&u, TruthDisplay::Rays).unwrap(),
+            vec![Some(3.0); 2]
+        );
+        let heat = truth_heat(&rays, 3, 1);
+        assert_eq!(heat.max, 4.0);
+        // The top of the scale is the gradient's last colour, unknown pixels dark grey.
+        let top = heat_gradient().sample(1.0);
+        assert!((heat.image.pixels[1][0] - top[0] as f32).abs() < 1e-6);
+        let unknown = truth_heat(&[None, Some(f64::NAN)], 2, 1);
+        assert_eq!(unknown.image.pixels, vec![UNKNOWN; 2]);
+        assert_eq!(unknown.max, 0.0);
+    }
+}
