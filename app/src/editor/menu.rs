@@ -120,12 +120,13 @@ impl EditorApp {
                     .on_hover_text(
                         "Give each ground-truth pixel its own ray count, in proportion to its predicted and measured noise (BSSBH13 Sec. 2.4), instead of the same count everywhere; the plane only (the cylinder stays uniform)",
                     );
-                ui.menu_button("Ground truth shows", |ui| {
-                    for d in TruthDisplay::ALL {
-                        ui.radio_value(&mut self.view.truth_display, d, d.label())
-                            .on_hover_text(d.help());
-                    }
-                });
+                ui.separator();
+                ui.weak("Ground truth shows");
+                for d in TruthDisplay::ALL {
+                    ui.radio_value(&mut self.view.truth_display, d, d.label())
+                        .on_hover_text(d.help());
+                }
+                ui.separator();
                 ui.checkbox(&mut self.view.show_plots, "Plots");
                 ui.checkbox(&mut self.report.open, "Error against run time report");
                 self.command_button(ui, "Sweep zoom", Command::ToggleSweep);

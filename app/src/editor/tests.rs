@@ -1,6 +1,7 @@
 //! The editor driven through egui_kittest on the real wgpu renderer: load a preset, move sliders,
 //! drag a colour stop, undo and redo, toggle the error view, and snapshot the window.
 
+use super::view_state::TruthDisplay;
 use super::worker::DeviceSource;
 use super::*;
 use egui::{Key, Modifiers};
@@ -314,6 +315,41 @@ fn error_view_toggles_and_window_snapshots() {
     assert!(!h.state().view.show_error);
 }
 
+/// View → Adaptive ground truth and View → Ground truth shows → rays per pixel: the truth
+/// viewport shows its uneven ray counts as a heat map scaled to the largest count.
+#[test]
+fn adaptive_truth_shows_its_ray_counts() {
+    let mut h = harness(900.0, 500.0, DeviceSource::Headless);
+    if !device_ready(&mut h, "adaptive_truth_shows_its_ray_counts") {
+        return;
+    }
+    h.state_mut().view.camera.elevation_deg = 78.0;
+    h.get_by_label("View").click();
+    h.step();
+    h.step();
+    h.get_by_label("Adaptive ground truth").click();
+    h.step();
+    assert!(h.state().view.adaptive_truth);
+    // A click in a menu closes it.
+    h.get_by_label("View").click();
+    h.step();
+    h.step();
+    h.get_by_label("rays per pixel").click();
+    h.step();
+    h.step();
+    assert_eq!(h.state().view.truth_display, TruthDisplay::Rays);
+    settle(&mut h, Duration::from_secs(240));
+    let app = h.state();
+    let truth = &app.shown[&ViewMode::Truth].frame;
+    let rays = truth.rays.as_deref().expect("adaptive ray counts");
+    let mean = rays.iter().map(|r| f64::from(*r)).sum::<f64>() / rays.len() as f64;
+    assert!((mean - 4.0).abs() < 0.01, "{mean} rays per pixel");
+    let heat = app.truth_heat.as_ref().expect("the rays map");
+    let max = rays.iter().copied().max().unwrap_or(0);
+    assert_eq!(heat.max, f64::from(max));
+    assert!(heat.max > 4.0, "uneven counts: at most {max}");
+}
+
 #[test]
 fn default_window_snapshot_at_1280x720() {
     let mut h = harness(1280.0, 720.0, DeviceSource::Headless);
@@ -424,6 +460,14 @@ fn regenerate_app_screenshots() {
             h.get_by_label(header).click_accesskit();
             h.step();
         }
+    });
+    shoot("adaptive-truth-rays", &|h| {
+        // Adaptive ground truth at a grazing view, its ray counts in the truth viewport.
+        let app = h.state_mut();
+        app.view.camera.elevation_deg = 80.0;
+        app.view.camera.distance = 6.0;
+        app.view.adaptive_truth = true;
+        app.view.truth_display = TruthDisplay::Rays;
     });
     shoot("snow-under-sky-grazing", &|h| {
         let ctx = h.ctx.clone();
