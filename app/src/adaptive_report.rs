@@ -20,8 +20,33 @@ use std::fmt::Write as _;
 /// Ray budgets (rays per pixel on average) of the adaptive ground truth, by default.
 pub const ADAPTIVE_RPP: [f64; 3] = [4.0, 16.0, 64.0];
 
-/// The adaptive strategies compared: name and lattice step.
-pub const STRATEGIES: [(&str, usize); 2] = [("ray counts", 1), ("lattice 4, refined", 4)];
+/// How an adaptive ground truth spends its budget.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Strategy {
+    /// [`lodestone_render::adaptive_truth::render_adaptive`]'s two passes on a lattice of this
+    /// step (1: ray counts only).
+    TwoPass(usize),
+    /// [`lodestone_render::adaptive_truth::render_progressive`]'s doubling rounds (the editor's),
+    /// cost-aware or not.
+    Progressive {
+        /// Shares divided by √(measured cost per ray).
+        cost_aware: bool,
+    },
+}
+
+/// The adaptive strategies compared, by name.
+pub const STRATEGIES: [(&str, Strategy); 4] = [
+    ("ray counts", Strategy::TwoPass(1)),
+    ("lattice 4, refined", Strategy::TwoPass(4)),
+    (
+        "progressive counts",
+        Strategy::Progressive { cost_aware: false },
+    ),
+    (
+        "progressive, cost-aware",
+        Strategy::Progressive { cost_aware: true },
+    ),
+];
 
 /// Uniform ground truth at one ray count.
 #[derive(Clone, Debug, Serialize)]
@@ -255,7 +280,7 @@ pub fn chart(
             .collect();
         series.push((
             format!("adaptive, {strategy}"),
-            ["#d62728", "#1f77b4"][i % 2],
+            ["#d62728", "#1f77b4", "#2ca02c", "#9467bd"][i % 4],
             pts,
             true,
         ));

@@ -18,19 +18,22 @@
 //!   timestamp queries are not used. On the software adapter they are CPU times.
 
 use crate::adaptive_report::{
-    ADAPTIVE_RPP, AdaptiveResult, STRATEGIES, UniformPoint, rmse_true, uniform_rays_at,
+    ADAPTIVE_RPP, AdaptiveResult, STRATEGIES, Strategy, UniformPoint, rmse_true, uniform_rays_at,
 };
 use crate::chart::{Chart, Series};
 use crate::cielab::delta_e76;
 use crate::preset_io::Resolved;
 use anyhow::{Context, Result};
 use glam::DVec3;
+use lodestone_core::eval::sampling_plan::SamplingPlan;
 use lodestone_core::microfacet::effective_height::HeightFilter;
 use lodestone_core::microfacet::masking_shadowing::Correlation;
 use lodestone_core::scene::camera::Camera;
 use lodestone_core::scene::direction::direction;
 use lodestone_core::scene::shape::Shape;
-use lodestone_render::adaptive_truth::{AdaptiveOptions, render_adaptive};
+use lodestone_render::adaptive_truth::{
+    AdaptiveOptions, AdaptiveTruth, Progressive, render_adaptive, render_progressive,
+};
 use lodestone_render::truth_noise::{BlockErrors, TruthEstimate};
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
@@ -432,15 +435,40 @@ fn adaptive_truth(
     let mut out = Vec::new();
     let mut tgt = ViewTarget::new(r, opts.size.0, opts.size.1)?;
     for &budget in &opts.adaptive {
-        for (strategy, step) in STRATEGIES {
-            let a_opts = AdaptiveOptions {
-                rays_per_pixel: budget,
-                step,
-                max_rays: opts.reference_spp.max(2) / 2,
-            };
+        for (strategy, how) in STRATEGIES {
+            // At most half the reference's rays a pixel, so every shaded pixel is a prefix of it.
+            let max_rays = opts.reference_spp.max(2) / 2;
             // One run, as the uniform truth's milestones: its passes are long enough to time once.
             let t = Instant::now();
-            let a = render_adaptive(r, &mut tgt, gm, scene, &prediction, a_opts)?;
+            let a = match how {
+                Strategy::TwoPass(step) => {
+                    let a_opts = AdaptiveOptions {
+                        rays_per_pixel: budget,
+                        step,
+                        max_rays,
+                    };
+                    render_adaptive(r, &mut tgt, gm, scene, &prediction, a_opts)?
+                }
+                Strategy::Progressive { cost_aware } => {
+                    let plan = Progressive {
+                        predicted: &prediction.sd,
+                        rays_per_pixel: budget,
+                        max_rays,
+                        cost_aware,
+                    };
+                    let rays =
+                        render_progressive(r, &mut tgt, gm, scene, plan, |_, _, _| Ok(true))?;
+                    AdaptiveTruth {
+                        image: tgt.read(r)?,
+                        plan: SamplingPlan {
+                            width: opts.size.0 as usize,
+                            height: opts.size.1 as usize,
+                            step: 1,
+                            rays,
+                        },
+                    }
+                }
+            };
             let ms = t.elapsed().as_secs_f64() * 1e3;
             let err = rmse_true(&a.image, reference, &|p| a.plan.rays[p] > 0);
             out.push(AdaptiveResult {

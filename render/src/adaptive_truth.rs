@@ -8,6 +8,7 @@
 //! ([`SamplingPlan::refine`]: cells whose measured residual from the prediction is not smooth are
 //! shaded whole) with the rest. Uniform sampling is `Renderer::draw` with the same total.
 
+use crate::truth_noise::SampleMoments;
 use crate::{LinearImage, RenderError, Renderer, Scene, ViewTarget};
 use lodestone_core::eval::sampling_plan::SamplingPlan;
 use lodestone_core::eval::truth_prediction::TruthPrediction;
@@ -151,14 +152,20 @@ pub fn pixel_deviations(predicted: &[f64], measured: &[(u32, f64)]) -> Vec<f64> 
 }
 
 /// Ray targets for the next round of a progressive adaptive ground truth: `mean_rays` rays per
-/// pixel on average over the image, in proportion to `deviation + DEFENSIVE·mean(deviation)`
-/// (Neyman allocation [BSSBH13 Sec. 2.4], with the defensive mixture of [`render_adaptive`]),
+/// pixel on average over the image, in proportion to `deviation + DEFENSIVE·mean(deviation)·
+/// PRIOR_RAYS/(PRIOR_RAYS + n − 1)` with `n` the rays the pixel has (Neyman allocation
+/// [BSSBH13 Sec. 2.4], with the defensive mixture of [`render_adaptive`], which fades as the
+/// pixel's own rays replace the prediction in [`pixel_deviations`]),
+/// divided by `√(cost/mean cost)` where `cost` (one ray's cost per pixel) is given: for a time
+/// budget `Σ c_p n_p` the error `Σ σ_p²/n_p` is least at `n_p ∝ σ_p/√c_p` (an empty or short
+/// `cost`, or an entry that is not finite and positive, counts as the mean of the known ones),
 /// never fewer than a pixel has (`current`) nor than one, never more than `max_rays` (unless it
 /// has them already). The total is `mean_rays × pixels` rounded, or what the floors force beyond
 /// it; what the caps leave over goes to the others (water filling). Empty input gives an empty
 /// plan; non-finite deviations count as 0.
 pub fn progressive_counts(
     deviation: &[f64],
+    cost: &[f64],
     current: &[u32],
     mean_rays: f64,
     max_rays: u32,
@@ -173,11 +180,36 @@ pub fn progressive_counts(
         .collect();
     let mean_dev = dev.iter().sum::<f64>() / n as f64;
     // All deviations 0 (or unknown): uniform.
-    let weight: Vec<f64> = if mean_dev > 0.0 {
-        dev.iter().map(|d| d + DEFENSIVE * mean_dev).collect()
+    // The defensive share guards against a wrong prediction; as a pixel's own rays take over its
+    // deviation (pixel_deviations: the prediction weighs PRIOR_RAYS against n − 1), it shrinks
+    // in the same proportion, so sky and flat shadow stop taking a third of the average.
+    let mut weight: Vec<f64> = if mean_dev > 0.0 {
+        dev.iter()
+            .enumerate()
+            .map(|(p, d)| {
+                let n = f64::from(current.get(p).copied().unwrap_or(0).max(1));
+                d + DEFENSIVE * mean_dev * PRIOR_RAYS / (PRIOR_RAYS + n - 1.0)
+            })
+            .collect()
     } else {
         vec![1.0; n]
     };
+    let known: Vec<f64> = cost
+        .iter()
+        .copied()
+        .filter(|c| c.is_finite() && *c > 0.0)
+        .collect();
+    if !known.is_empty() {
+        let mean_cost = known.iter().sum::<f64>() / known.len() as f64;
+        for (p, w) in weight.iter_mut().enumerate() {
+            let c = cost
+                .get(p)
+                .copied()
+                .filter(|c| c.is_finite() && *c > 0.0)
+                .unwrap_or(mean_cost);
+            *w /= (c / mean_cost).sqrt();
+        }
+    }
     let floor: Vec<f64> = (0..n)
         .map(|p| f64::from(current.get(p).copied().unwrap_or(0).max(1)))
         .collect();
@@ -220,6 +252,113 @@ pub fn progressive_counts(
         .collect()
 }
 
+/// Per pixel of a truth image and its squared sums: (rays, sample variance of their luminance),
+/// the measurement [`pixel_deviations`] pools with the prediction.
+pub fn luminance_variances(image: &LinearImage, moments: &SampleMoments) -> Vec<(u32, f64)> {
+    image
+        .pixels
+        .iter()
+        .zip(&moments.sum_sq)
+        .map(|(p, q)| {
+            let n = f64::from(p[3]);
+            let s = crate::truth_noise::luminance([0, 1, 2].map(|k| f64::from(p[k])));
+            let var = if n >= 2.0 {
+                ((f64::from(q[3]) - s * s / n) / (n - 1.0)).max(0.0)
+            } else {
+                0.0
+            };
+            (n.max(0.0) as u32, var)
+        })
+        .collect()
+}
+
+/// What a progressive adaptive ground truth plans with ([`render_progressive`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Progressive<'a> {
+    /// One ray's predicted luminance deviation per pixel ([`TruthPrediction::sd`]).
+    pub predicted: &'a [f64],
+    /// Rays per pixel on average at the end.
+    pub rays_per_pixel: f64,
+    /// The most rays any one pixel gets.
+    pub max_rays: u32,
+    /// Weigh each pixel's share by `1/√(its cost per ray)` as measured by the rays so far
+    /// ([`ViewTarget::read_work`]): the least error for the time rather than for the rays.
+    pub cost_aware: bool,
+}
+
+/// Render a progressive adaptive ground truth into `target` (reset first): rounds of doubling
+/// budgets, 1, 2, 4, … up to `plan.rays_per_pixel` rays per pixel on average, each giving the
+/// pixels rays by [`progressive_counts`] (at most `plan.max_rays` each) from `plan.predicted`
+/// pooled with what each pixel's rays measured by the
+/// round's start ([`pixel_deviations`]). A round is traced in steps of about one ray per pixel;
+/// after each, `on_step(target, rays, round_end)` may look at the target and returns whether to
+/// go on. Returns the rays per pixel traced.
+///
+/// Unlike [`render_adaptive`]'s two passes, every pixel is shaded (no lattice: on noise-limited
+/// images interpolation lost, docs/design.md), and the plan learns from each round, so a pixel
+/// whose noise the model missed catches up at the next.
+pub fn render_progressive(
+    renderer: &Renderer,
+    target: &mut ViewTarget,
+    material: &crate::GpuMaterial,
+    scene: &Scene,
+    plan: Progressive,
+    mut on_step: impl FnMut(&ViewTarget, &[u32], bool) -> Result<bool, RenderError>,
+) -> Result<Vec<u32>, RenderError> {
+    let (w, h) = target.size();
+    let n = (w as usize) * (h as usize);
+    target.reset();
+    let goal_rpp = if plan.rays_per_pixel.is_finite() {
+        plan.rays_per_pixel.max(1.0)
+    } else {
+        1.0
+    };
+    let mut have = vec![0_u32; n];
+    let mut measured: Vec<(u32, f64)> = Vec::new();
+    let mut cost: Vec<f64> = Vec::new();
+    let mut budget = 1.0_f64.min(goal_rpp);
+    loop {
+        let goal = progressive_counts(
+            &pixel_deviations(plan.predicted, &measured),
+            &cost,
+            &have,
+            budget,
+            plan.max_rays,
+        );
+        let extra: u64 = goal
+            .iter()
+            .zip(&have)
+            .map(|(g, h)| u64::from(g.saturating_sub(*h)))
+            .sum();
+        let steps = extra.div_ceil(n.max(1) as u64).max(1);
+        let start = have.clone();
+        for step in 1..=steps {
+            for (p, h) in have.iter_mut().enumerate() {
+                let add = u64::from(goal[p].saturating_sub(start[p]));
+                *h = start[p] + (add * step).div_ceil(steps) as u32;
+            }
+            renderer.draw_planned(target, material, scene, &have);
+            if !on_step(target, &have, step == steps)? {
+                return Ok(have);
+            }
+        }
+        if budget >= goal_rpp {
+            return Ok(have);
+        }
+        measured = luminance_variances(&target.read(renderer)?, &target.read_moments(renderer)?);
+        if plan.cost_aware {
+            // Cost per ray, plus one unit for the ray's setup and shading.
+            cost = target
+                .read_work(renderer)?
+                .iter()
+                .zip(&have)
+                .map(|(w, n)| 1.0 + f64::from(*w) / f64::from((*n).max(1)))
+                .collect();
+        }
+        budget = (budget * 2.0).min(goal_rpp);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -228,12 +367,49 @@ mod tests {
     fn counts_follow_the_deviation_and_spend_the_budget() {
         // Deviations 1 and 3 (mean 2): weights 2 and 4, so 16 rays a pixel on average go 2:4.
         let dev = [1.0, 3.0, 1.0, 3.0];
-        let c = progressive_counts(&dev, &[0; 4], 16.0, 1000);
+        let c = progressive_counts(&dev, &[], &[0; 4], 16.0, 1000);
         assert_eq!(c.iter().sum::<u32>(), 64);
         assert!(c[0].abs_diff(11) <= 1 && c[1].abs_diff(21) <= 1, "{c:?}");
         // Equal deviations (or none known) are uniform.
-        assert_eq!(progressive_counts(&[0.5; 6], &[0; 6], 4.0, 100), vec![4; 6]);
-        assert_eq!(progressive_counts(&[0.0; 3], &[0; 3], 2.0, 100), vec![2; 3]);
+        assert_eq!(
+            progressive_counts(&[0.5; 6], &[], &[0; 6], 4.0, 100),
+            vec![4; 6]
+        );
+        assert_eq!(
+            progressive_counts(&[0.0; 3], &[], &[0; 3], 2.0, 100),
+            vec![2; 3]
+        );
+    }
+
+    #[test]
+    fn costly_pixels_get_fewer_rays_by_the_square_root() {
+        // Equal deviations, one pixel four times as costly: half the rays of the others
+        // (n ∝ σ/√c); unknown costs count as the mean of the known ones.
+        let c = progressive_counts(&[1.0; 4], &[4.0, 1.0, 1.0], &[0; 4], 14.0, 1000);
+        assert_eq!(c.iter().sum::<u32>(), 56);
+        let mean_cost: f64 = 2.0;
+        let w = [
+            1.0 / (4.0 / mean_cost).sqrt(),
+            1.0 / (1.0 / mean_cost).sqrt(),
+            1.0 / (1.0 / mean_cost).sqrt(),
+            1.0,
+        ];
+        let sum: f64 = w.iter().sum();
+        for (got, w) in c.iter().zip(w) {
+            assert!((f64::from(*got) - 56.0 * w / sum).abs() <= 1.0, "{c:?}");
+        }
+    }
+
+    #[test]
+    fn the_defensive_share_fades_with_a_pixels_own_rays() {
+        // Pixel 0 is quiet (deviation 0) and has 4 rays: its defensive weight is
+        // 0.5·0.75·4/7 = 0.21 against 0.375 before it had any, so it gets about 5 of 100 rays
+        // instead of 8.
+        let c = progressive_counts(&[0.0, 1.0, 1.0, 1.0], &[], &[4, 1, 1, 1], 25.0, 1000);
+        assert_eq!(c.iter().sum::<u32>(), 100);
+        assert!((4..=6).contains(&c[0]), "{c:?}");
+        let fresh = progressive_counts(&[0.0, 1.0, 1.0, 1.0], &[], &[0; 4], 25.0, 1000);
+        assert!((7..=9).contains(&fresh[0]), "{fresh:?}");
     }
 
     #[test]
@@ -241,26 +417,35 @@ mod tests {
         // One pixel far noisier than the rest is capped; the rays it cannot take go elsewhere.
         let mut dev = vec![0.1; 10];
         dev[3] = 100.0;
-        let c = progressive_counts(&dev, &[0; 10], 8.0, 20);
+        let c = progressive_counts(&dev, &[], &[0; 10], 8.0, 20);
         assert_eq!(c[3], 20);
         assert_eq!(c.iter().sum::<u32>(), 80);
         assert!(c.iter().all(|&r| r >= 1));
         // A pixel never loses rays it has, and every pixel gets one.
         let cur = [9, 0, 0, 0];
-        let c = progressive_counts(&[0.0, 1.0, 1.0, 1.0], &cur, 2.0, 100);
+        let c = progressive_counts(&[0.0, 1.0, 1.0, 1.0], &[], &cur, 2.0, 100);
         assert!(c[0] >= 9 && c.iter().all(|&r| r >= 1), "{c:?}");
         // The floors may exceed the budget: then they are the plan.
-        assert_eq!(progressive_counts(&[1.0; 2], &[5, 7], 1.0, 100), vec![5, 7]);
+        assert_eq!(
+            progressive_counts(&[1.0; 2], &[], &[5, 7], 1.0, 100),
+            vec![5, 7]
+        );
     }
 
     #[test]
     fn hostile_inputs_still_give_a_plan() {
-        assert!(progressive_counts(&[], &[], 4.0, 10).is_empty());
-        let c = progressive_counts(&[f64::NAN, f64::INFINITY, -1.0, 1.0], &[], f64::NAN, 0);
+        assert!(progressive_counts(&[], &[], &[], 4.0, 10).is_empty());
+        let c = progressive_counts(
+            &[f64::NAN, f64::INFINITY, -1.0, 1.0],
+            &[f64::NAN, -1.0],
+            &[],
+            f64::NAN,
+            0,
+        );
         assert_eq!(c, vec![1; 4]);
-        let c = progressive_counts(&[1.0, 2.0], &[], f64::INFINITY, 1 << 20);
+        let c = progressive_counts(&[1.0, 2.0], &[], &[], f64::INFINITY, 1 << 20);
         assert_eq!(c, vec![1, 1]);
-        let c = progressive_counts(&[1e300, 1e-300], &[], 1e6, u32::MAX);
+        let c = progressive_counts(&[1e300, 1e-300], &[1e300, 1e-300], &[], 1e6, u32::MAX);
         assert!(c.iter().all(|&r| r >= 1));
     }
 

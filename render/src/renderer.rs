@@ -200,6 +200,8 @@ pub struct ViewTarget {
     scratch: wgpu::Buffer,
     /// The pixels or rays whose march had a loop cut by the adapter (binding 7, one u32).
     cut: wgpu::Buffer,
+    /// Ground truth's work per pixel (binding 8, one u32 each: the view shader's `work_sum`).
+    work: wgpu::Buffer,
     /// Ground-truth rays per pixel accumulated so far (the most any pixel has, after
     /// [`Renderer::draw_planned`]).
     pub samples: u32,
@@ -299,6 +301,14 @@ impl ViewTarget {
                 | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        let work = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("work per pixel"),
+            size: (u64::from(width) * u64::from(height) * 4).max(16),
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::COPY_SRC
+                | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         Ok(Self {
             width,
             height,
@@ -308,6 +318,7 @@ impl ViewTarget {
             order,
             scratch,
             cut,
+            work,
             samples: 0,
             planned: None,
         })
@@ -341,6 +352,31 @@ impl ViewTarget {
         renderer.ctx.queue.submit([enc.finish()]);
         let words = map_words(renderer, &readback)?;
         Ok(words.first().copied().unwrap_or(0))
+    }
+
+    /// Ground truth's work per pixel since the target last started (waits for the GPU): the sum
+    /// over the pixel's rays of each ray's march steps plus its waves summed in eights (the view
+    /// shader's `work`). Divided by the pixel's rays it is what one more ray there costs, in
+    /// units comparable across pixels of one material ([`crate::adaptive_truth`]'s cost-aware
+    /// counts). Row-major; rays traced again after a loop cut are not counted.
+    pub fn read_work(&self, renderer: &Renderer) -> Result<Vec<u32>, RenderError> {
+        let n = (self.width as usize) * (self.height as usize);
+        let bytes = (n as u64 * 4).max(16);
+        let device = &renderer.ctx.device;
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("readback"),
+        });
+        enc.copy_buffer_to_buffer(&self.work, 0, &readback, 0, bytes);
+        renderer.ctx.queue.submit([enc.finish()]);
+        let mut words = map_words(renderer, &readback)?;
+        words.truncate(n);
+        Ok(words)
     }
 
     /// Log a warning when [`cut_count`](Self::cut_count) is above 0 (what `mode` drew here).
@@ -1282,6 +1318,7 @@ impl Renderer {
                 enc.clear_buffer(&target.accum, 0, None);
                 enc.clear_buffer(&target.moments, 0, None);
                 enc.clear_buffer(&target.cut, 0, None);
+                enc.clear_buffer(&target.work, 0, None);
                 self.ctx.queue.submit([enc.finish()]);
                 target.samples = 1;
             }
@@ -1379,6 +1416,7 @@ impl Renderer {
             &target.order,
             &target.scratch,
             &target.cut,
+            &target.work,
         ];
         let entries: Vec<wgpu::BindGroupEntry> = entries
             .iter()
@@ -1422,7 +1460,7 @@ impl Renderer {
         self.dispatch_view(target, pipeline, bind, &p, slots.div_ceil(batches_per_row));
     }
 
-    /// Zero the target's count of cut loops.
+    /// Zero the target's count of cut loops and its work per pixel.
     fn clear_cut(&self, target: &ViewTarget) {
         let mut enc = self
             .ctx
@@ -1431,6 +1469,7 @@ impl Renderer {
                 label: Some("clear"),
             });
         enc.clear_buffer(&target.cut, 0, None);
+        enc.clear_buffer(&target.work, 0, None);
         self.ctx.queue.submit([enc.finish()]);
     }
 

@@ -756,6 +756,7 @@ fn check_planned_against_uniform(r: &Renderer, elevation: f64, frames: u32) -> u
         at.push((
             uniform.read(r).expect("readback").pixels,
             uniform.read_moments(r).expect("readback").sum_sq,
+            uniform.read_work(r).expect("readback"),
         ));
         assert_eq!(uniform.samples, k);
     }
@@ -770,6 +771,7 @@ fn check_planned_against_uniform(r: &Renderer, elevation: f64, frames: u32) -> u
         })
         .map(|c| c.min(frames))
         .collect();
+    let uncut = uniform.cut_count(r).expect("readback") == 0;
     let mut planned = lodestone_render::ViewTarget::new(r, w, h).expect("target");
     // A target that held something else starts afresh.
     r.draw(&mut planned, &gm, &scene, ViewMode::Truth, 2);
@@ -778,8 +780,21 @@ fn check_planned_against_uniform(r: &Renderer, elevation: f64, frames: u32) -> u
         assert_eq!(planned.planned_rays(), Some(rays.as_slice()));
         let img = planned.read(r).expect("readback").pixels;
         let sq = planned.read_moments(r).expect("readback").sum_sq;
+        let work = planned.read_work(r).expect("readback");
         for p in 0..n {
             let k = rays[p] as usize;
+            // Each ray's work (march steps and waves summed) is counted once, whichever path
+            // traced it: every ray takes at least one step, and with no loop cut (which
+            // depends on a ray's batch) the sums are the uniform ones.
+            let want_work = if k == 0 { 0 } else { at[k - 1].2[p] };
+            assert!(
+                work[p] >= rays[p],
+                "pixel {p}: work {} for {k} rays",
+                work[p]
+            );
+            if uncut {
+                assert_eq!(work[p], want_work, "pixel {p} ({k} rays): work");
+            }
             let (want, want_sq) = if k == 0 {
                 ([0.0; 4], [0.0; 4])
             } else {

@@ -18,7 +18,7 @@ use lodestone_core::material::Material;
 use lodestone_core::material::measured::MeasuredBrdf;
 use lodestone_core::math::sh::Sh9;
 use lodestone_core::scene::shape::Shape;
-use lodestone_render::adaptive_truth::{pixel_deviations, progressive_counts};
+use lodestone_render::adaptive_truth::{Progressive, render_progressive};
 use lodestone_render::truth_noise::SampleMoments;
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
@@ -451,11 +451,9 @@ impl State {
 
     /// Adaptive ground truth (#18 §1): core predicts each pixel's ray deviation once (on a grid
     /// of at most [`PREDICT_SIDE`] pixels a side, nearest-upsampled: the allocation needs its
-    /// shape, not its detail), then rounds of doubling budgets (1, 2, 4, … up to `truth_spp` rays
-    /// per pixel on average) give each pixel rays in proportion to its deviation, pooled with
-    /// what its own rays measured ([`pixel_deviations`], [`progressive_counts`]). Each round is
-    /// traced in steps of about one ray per pixel, so a newer request waits no longer than for a
-    /// uniform frame.
+    /// shape, not its detail), then [`render_progressive`] traces rounds of doubling budgets up to
+    /// `truth_spp` rays per pixel on average, each in steps of about one ray per pixel, so a newer
+    /// request waits no longer than for a uniform frame.
     fn accumulate_adaptive(
         &mut self,
         req: &Request,
@@ -467,92 +465,66 @@ impl State {
         let Some(mut target) = self.truth_target(size, send) else {
             return Ok(None);
         };
-        target.reset();
-        let Some(prepared) = &self.prepared else {
+        let (Some(prepared), Some((_, gm))) = (&self.prepared, &self.material) else {
             self.truth = Some(target);
             return Ok(None);
         };
         let predicted = predicted_deviation(prepared, &req.scene, size);
         let predicted_f32 = Arc::new(predicted.iter().map(|v| *v as f32).collect::<Vec<_>>());
-        let n = predicted.len();
         let spp = req.truth_spp.max(1);
-        let max_rays = spp.saturating_mul(MAX_RAYS_FACTOR).max(16);
-        let mut have = vec![0_u32; n];
-        let mut measured: Vec<(u32, f64)> = Vec::new();
+        let plan = Progressive {
+            predicted: &predicted,
+            rays_per_pixel: f64::from(spp),
+            max_rays: spp.saturating_mul(MAX_RAYS_FACTOR).max(16),
+            cost_aware: true,
+        };
+        let renderer = &self.renderer;
+        let mut outcome: Result<Option<Request>, ()> = Ok(None);
         let mut last_sent = Instant::now() - Duration::from_secs(1);
-        let mut budget = 1_u32;
-        let result = 'rounds: loop {
-            let goal = progressive_counts(
-                &pixel_deviations(&predicted, &measured),
-                &have,
-                f64::from(budget),
-                max_rays,
-            );
-            let extra: u64 = goal
-                .iter()
-                .zip(&have)
-                .map(|(g, h)| u64::from(g.saturating_sub(*h)))
-                .sum();
-            // Steps of about one ray per pixel each.
-            let steps = extra.div_ceil(n.max(1) as u64).max(1);
-            let start = have.clone();
-            for step in 1..=steps {
-                let Some((_, gm)) = &self.material else {
-                    break 'rounds Ok(None);
-                };
-                for (p, h) in have.iter_mut().enumerate() {
-                    let add = u64::from(goal[p] - start[p]);
-                    *h = start[p] + (add * step).div_ceil(steps) as u32;
-                }
-                let t0 = Instant::now();
-                self.renderer
-                    .draw_planned(&mut target, gm, &req.scene, &have);
-                self.renderer.wait();
+        let mut t0 = Instant::now();
+        let traced = render_progressive(
+            renderer,
+            &mut target,
+            gm,
+            &req.scene,
+            plan,
+            |target, rays, round_end| {
+                renderer.wait();
                 let dt = t0.elapsed();
-                let done = budget >= spp && step == steps;
-                if step == steps || last_sent.elapsed() > Duration::from_millis(120) {
-                    let read = target.read(&self.renderer).and_then(|image| {
-                        Ok((
-                            image,
-                            target.read_moments(&self.renderer)?,
-                            target.cut_count(&self.renderer)?,
-                        ))
-                    });
-                    match read {
-                        Ok((image, moments, cut_rays)) => {
-                            measured = luminance_variances(&image, &moments);
-                            let total: u64 = have.iter().map(|r| u64::from(*r)).sum();
-                            send(Event::Frame(Frame {
-                                generation: req.generation,
-                                mode: ViewMode::Truth,
-                                image: Arc::new(image),
-                                samples: (total as f64 / n.max(1) as f64).round() as u32,
-                                rays: Some(Arc::new(have.clone())),
-                                predicted_sd: Some(predicted_f32.clone()),
-                                moments: Some(Arc::new(moments)),
-                                pass_time: dt,
-                                cut_rays,
-                                scale,
-                            }));
-                        }
-                        Err(e) => {
-                            send(Event::RenderError(e.to_string()));
-                            break 'rounds Ok(None);
-                        }
-                    }
+                let total: u64 = rays.iter().map(|r| u64::from(*r)).sum();
+                let mean = (total as f64 / rays.len().max(1) as f64).round() as u32;
+                if round_end || last_sent.elapsed() > Duration::from_millis(120) {
+                    let image = target.read(renderer)?;
+                    let moments = target.read_moments(renderer)?;
+                    let cut_rays = target.cut_count(renderer)?;
+                    send(Event::Frame(Frame {
+                        generation: req.generation,
+                        mode: ViewMode::Truth,
+                        image: Arc::new(image),
+                        samples: mean,
+                        rays: Some(Arc::new(rays.to_vec())),
+                        predicted_sd: Some(predicted_f32.clone()),
+                        moments: Some(Arc::new(moments)),
+                        pass_time: dt,
+                        cut_rays,
+                        scale,
+                    }));
                     last_sent = Instant::now();
                 }
+                t0 = Instant::now();
                 match Self::newest(rx) {
-                    Err(()) => break 'rounds Err(()),
-                    Ok(Some(newer)) => break 'rounds Ok(Some(newer)),
-                    Ok(None) if done => break 'rounds Ok(None),
-                    Ok(None) => {}
+                    Err(()) => outcome = Err(()),
+                    Ok(Some(newer)) => outcome = Ok(Some(newer)),
+                    Ok(None) => return Ok(true),
                 }
-            }
-            budget = budget.saturating_mul(2).min(spp);
-        };
+                Ok(false)
+            },
+        );
+        if let Err(e) = traced {
+            send(Event::RenderError(e.to_string()));
+        }
         self.truth = Some(target);
-        result
+        outcome
     }
 
     fn accumulate_truth(
@@ -640,25 +612,6 @@ fn predicted_deviation(prepared: &Evaluator, scene: &Scene, (w, h): (u32, u32)) 
         }
     }
     out
-}
-
-/// Per pixel of a truth image and its squared sums: (rays, sample variance of their luminance).
-fn luminance_variances(image: &LinearImage, moments: &SampleMoments) -> Vec<(u32, f64)> {
-    image
-        .pixels
-        .iter()
-        .zip(&moments.sum_sq)
-        .map(|(p, q)| {
-            let n = f64::from(p[3]);
-            let s = lodestone_render::truth_noise::luminance([0, 1, 2].map(|k| f64::from(p[k])));
-            let var = if n >= 2.0 {
-                ((f64::from(q[3]) - s * s / n) / (n - 1.0)).max(0.0)
-            } else {
-                0.0
-            };
-            (n.max(0.0) as u32, var)
-        })
-        .collect()
 }
 
 /// The hidden editor setting for the march (issue #15: every speed-up is a ratio measured in one

@@ -26,6 +26,16 @@ const SQRT_2: f32 = 1.4142135;
 // answer as right. Cleared per ray or pixel by the view.
 var<private> loop_cut: bool;
 
+// GPU only. The work of this invocation's ray (or pixel) so far, in units of eight waves summed plus
+// one per march step: what a ground-truth ray of a pixel costs, for cost-aware ray counts
+// (view.wgsl `work_sum`, ViewTarget::read_work). Private, so zero at every invocation's start.
+var<private> work: u32;
+
+// GPU only: add `units` to this invocation's work.
+fn note_work(units: u32) {
+    work = work + units;
+}
+
 // GPU only: record that a loop was cut (`cut` true).
 fn note_cut(cut: bool) {
     loop_cut = loop_cut || cut;

@@ -20,6 +20,11 @@
 // (bindings.wgsl `loop_cut`) since the target started (ViewTarget::cut_count).
 @group(0) @binding(7) var<storage, read_write> cut_count: array<atomic<u32>>;
 
+// Ground truth's work per pixel: the sum over its rays of each ray's `work` (bindings.wgsl: eight
+// waves summed per unit, plus one per march step), so a pixel's cost per ray is known
+// (ViewTarget::read_work; cost-aware adaptive plans). Cleared with the sums.
+@group(0) @binding(8) var<storage, read_write> work_sum: array<atomic<u32>>;
+
 // GPU only: count this invocation's pixel or ray when a loop of it was cut.
 fn count_cut() {
     if (loop_cut) {
@@ -101,6 +106,9 @@ fn view_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invoc
     }
     let c = truth_sample(ray.x, ray.y, view_params.light);
     let slot = ray.z;
+    if (view_params.phase == 0u) {
+        atomicAdd(&work_sum[ray.x], work);
+    }
     if (!listed) {
         // Ground truth, one ray per frame. A cut ray is traced again alone (phase 3) instead of
         // added here.

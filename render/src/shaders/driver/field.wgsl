@@ -11,6 +11,7 @@ fn value_and_gradient(x: vec2<f32>) -> vec3<f32> {
 //#endif
 //#if noise
     // Eight waves per iteration: see UNROLL.
+    note_work((params.wave_count + 7u) / 8u);
     var s = vec3<f32>(0.0);
     let n8 = params.wave_count & ~7u;
     var i = 0u;

@@ -20,6 +20,7 @@ fn march_heightfield(o: vec3<f32>, d: vec3<f32>, rate: f32, lod: bool, sf: f32) 
     var prev_g = 0.0;
     var relaxed = false;
     for (var it = 0u; it < 20000u; it = it + 1u) {
+        note_work(1u);
         let p = o + d * t;
         var gap = p.z - field_height(p.xy, lod, sf);
         if (gap < 0.0 && t == 0.0) {

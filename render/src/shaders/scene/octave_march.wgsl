@@ -91,6 +91,7 @@ fn octave_partial(first: u32, end: u32, x: vec2<f32>, dxy: vec2<f32>, lod: bool)
     var acc = vec3<f32>(0.0);
     var i = first;
     if (end > first) {
+        note_work((end - first + 7u) / 8u);
         let n8 = first + ((end - first) & ~7u);
         for (; i < n8; i = i + 8u) {
             acc = acc + octave_term(i, x, dxy, lod) + octave_term(i + 1u, x, dxy, lod)
@@ -312,6 +313,7 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
     var may_settle = 0u;
     var skip = 0.0;
     for (var it = 0u; it < 20000u; it = it + 1u) {
+        note_work(1u);
         let p = o + d * t;
         if ((d.z >= 0.0 && p.z > top) || (d.z < 0.0 && p.z < -top - 1.0)) {
             return -1.0;
