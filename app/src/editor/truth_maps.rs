@@ -40,6 +40,10 @@ pub(super) fn truth_values(frame: &Frame, display: TruthDisplay) -> Option<Vec<O
             let sd = frame.predicted_sd.as_deref()?;
             (sd.len() == n).then(|| sd.iter().map(|v| Some(f64::from(*v))).collect())
         }
+        TruthDisplay::Cost => {
+            let c = frame.cost.as_deref()?;
+            (c.len() == n).then(|| c.iter().map(|v| Some(f64::from(*v))).collect())
+        }
         TruthDisplay::Rays => Some(match frame.rays.as_deref() {
             Some(r) if r.len() == n => r.iter().map(|v| Some(f64::from(*v))).collect(),
             // Uniform truth: every pixel has the frame's rays (its weight).
@@ -109,6 +113,7 @@ mod tests {
             samples: 2,
             rays: rays.map(Arc::new),
             predicted_sd: Some(Arc::new(vec![0.5; n as usize])),
+            cost: Some(Arc::new(vec![2.0; n as usize])),
             moments: Some(Arc::new(SampleMoments {
                 width: n,
                 height: 1,
@@ -144,6 +149,10 @@ mod tests {
         let rays = truth_values(&f, TruthDisplay::Rays).unwrap();
         assert_eq!(rays, vec![Some(2.0), Some(4.0), Some(1.0)]);
         assert!(truth_values(&f, TruthDisplay::Image).is_none());
+        assert_eq!(
+            truth_values(&f, TruthDisplay::Cost).unwrap(),
+            vec![Some(2.0); 3]
+        );
         // A uniform truth's rays are its weights.
         let u = frame(vec![[0.0, 0.0, 0.0, 3.0]; 2], vec![[0.0; 4]; 2], None);
         assert_eq!(

@@ -113,15 +113,18 @@ pub enum TruthDisplay {
     PredictedDeviation,
     /// The rays each pixel has.
     Rays,
+    /// What one more ray costs per pixel (march steps plus eights of waves summed).
+    Cost,
 }
 
 impl TruthDisplay {
     /// Every choice.
-    pub const ALL: [Self; 4] = [
+    pub const ALL: [Self; 5] = [
         Self::Image,
         Self::StandardError,
         Self::PredictedDeviation,
         Self::Rays,
+        Self::Cost,
     ];
 
     /// Menu and title text.
@@ -131,6 +134,7 @@ impl TruthDisplay {
             Self::StandardError => "standard error of the mean",
             Self::PredictedDeviation => "predicted ray deviation",
             Self::Rays => "rays per pixel",
+            Self::Cost => "cost per ray",
         }
     }
 
@@ -145,7 +149,10 @@ impl TruthDisplay {
                 "σ̂, one truth ray's luminance deviation predicted from the filtered model (Evaluator::predict_truth: visible colour, slopes, sun visibility, specular second moment); adaptive ground truth plans its rays with it [BSSBH13 Sec. 2.4]"
             }
             Self::Rays => {
-                "Rays each pixel has: uniform truth gives every pixel the same; adaptive truth gives them in proportion to σ̂ + ½·mean σ̂, pooled with each pixel's measured deviation"
+                "Rays each pixel has: uniform truth gives every pixel the same; adaptive truth gives them in proportion to (σ̂ + ½·mean σ̂, pooled with each pixel's measured deviation)/√(cost per ray)"
+            }
+            Self::Cost => {
+                "What one more ground-truth ray costs in each pixel: march steps plus eights of waves summed, averaged over its rays (rays that skim the relief toward the horizon march longest); adaptive truth gives pixels rays ∝ σ/√cost, the least error for the time"
             }
         }
     }

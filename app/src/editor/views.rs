@@ -428,7 +428,7 @@ impl EditorApp {
                 ui,
                 img,
                 &format!(
-                    "no {} for this truth: it needs adaptive ground truth on the plane (View menu)",
+                    "no {} for this truth yet: it needs adaptive ground truth on the plane (View menu)",
                     d.label()
                 ),
             );
@@ -570,6 +570,7 @@ fn heat_bar(ui: &Ui, img: Rect, max: &str, title: &str) {
 fn truth_legend(ui: &Ui, img: Rect, display: TruthDisplay, max: f64) {
     let (top, unit) = match display {
         TruthDisplay::Rays => (format!("{max:.0}"), "rays per pixel"),
+        TruthDisplay::Cost => (format!("{max:.0}"), "cost of a ray (march steps + waves/8)"),
         TruthDisplay::StandardError => (
             format!("{max:.3}"),
             "standard error of the mean luminance (grey: under 2 rays)",

@@ -72,6 +72,9 @@ pub struct Frame {
     /// The predicted deviation of one truth ray's luminance per pixel that planned them
     /// (`Evaluator::predict_truth`; `None` where nothing was predicted).
     pub predicted_sd: Option<Arc<Vec<f32>>>,
+    /// What one more truth ray costs per pixel, in march steps plus eights of waves summed (the
+    /// view shader's `work` over the pixel's rays, plus one; `None` for analytic modes).
+    pub cost: Option<Arc<Vec<f32>>>,
     /// Ground truth's per-pixel sums of squared rays (its own noise; `None` for analytic modes).
     pub moments: Option<Arc<SampleMoments>>,
     /// GPU time of the pass that produced it (for truth: of the last ray per pixel).
@@ -406,6 +409,7 @@ impl State {
                             samples: 0,
                             rays: None,
                             predicted_sd: None,
+                            cost: None,
                             moments: None,
                             pass_time: dt,
                             cut_rays: 0,
@@ -497,6 +501,7 @@ impl State {
                     let image = target.read(renderer)?;
                     let moments = target.read_moments(renderer)?;
                     let cut_rays = target.cut_count(renderer)?;
+                    let cost = ray_costs(&target.read_work(renderer)?, rays);
                     send(Event::Frame(Frame {
                         generation: req.generation,
                         mode: ViewMode::Truth,
@@ -504,6 +509,7 @@ impl State {
                         samples: mean,
                         rays: Some(Arc::new(rays.to_vec())),
                         predicted_sd: Some(predicted_f32.clone()),
+                        cost: Some(Arc::new(cost)),
                         moments: Some(Arc::new(moments)),
                         pass_time: dt,
                         cut_rays,
@@ -557,16 +563,21 @@ impl State {
                         image,
                         target.read_moments(&self.renderer)?,
                         target.cut_count(&self.renderer)?,
+                        target.read_work(&self.renderer)?,
                     ))
                 });
                 match read {
-                    Ok((image, moments, cut_rays)) => send(Event::Frame(Frame {
+                    Ok((image, moments, cut_rays, work)) => send(Event::Frame(Frame {
                         generation: req.generation,
                         mode: ViewMode::Truth,
                         image: Arc::new(image),
                         samples: target.samples,
                         rays: None,
                         predicted_sd: None,
+                        cost: Some(Arc::new(ray_costs(
+                            &work,
+                            &vec![target.samples; work.len()],
+                        ))),
                         moments: Some(Arc::new(moments)),
                         pass_time: dt,
                         cut_rays,
@@ -612,6 +623,16 @@ fn predicted_deviation(prepared: &Evaluator, scene: &Scene, (w, h): (u32, u32)) 
         }
     }
     out
+}
+
+/// One more ray's cost per pixel from the target's work (`ViewTarget::read_work`) over the
+/// pixel's rays: `1 + work/rays` (1 for the ray's setup and shading), as
+/// `render_progressive`'s cost-aware plan weighs it.
+fn ray_costs(work: &[u32], rays: &[u32]) -> Vec<f32> {
+    work.iter()
+        .zip(rays)
+        .map(|(w, n)| (1.0 + f64::from(*w) / f64::from((*n).max(1))) as f32)
+        .collect()
 }
 
 /// The hidden editor setting for the march (issue #15: every speed-up is a ratio measured in one
@@ -741,9 +762,12 @@ mod tests {
         }
         let (lo, hi) = (rays.iter().min().unwrap(), rays.iter().max().unwrap());
         assert!(*lo >= 1 && hi > lo, "rays {lo}..{hi}");
-        // Noisier predicted pixels got more rays on average.
+        // Pixels noisier for their cost (σ̂/√c: the plan is cost-aware) got more rays on average.
+        let cost = f.cost.as_deref().expect("its costs");
+        assert!(cost.iter().all(|c| *c >= 1.0));
+        let key: Vec<f32> = (0..n).map(|p| sd[p] / cost[p].sqrt()).collect();
         let mut order: Vec<usize> = (0..n).collect();
-        order.sort_by(|a, b| sd[*a].total_cmp(&sd[*b]));
+        order.sort_by(|a, b| key[*a].total_cmp(&key[*b]));
         let mean =
             |ix: &[usize]| ix.iter().map(|&p| f64::from(rays[p])).sum::<f64>() / ix.len() as f64;
         let (quiet, noisy) = (mean(&order[..n / 4]), mean(&order[3 * n / 4..]));
