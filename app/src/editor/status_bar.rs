@@ -42,7 +42,8 @@ impl EditorApp {
                         t += &format!(" @{:.0}%", f.scale * 100.0);
                     }
                     if m == ViewMode::Truth {
-                        t += &format!(" ({}/{} spp)", f.samples, self.view.truth_spp);
+                        let adaptive = if f.rays.is_some() { " adaptive" } else { "" };
+                        t += &format!(" ({}/{} spp{adaptive})", f.samples, self.view.truth_spp);
                     }
                     ui.weak(t);
                     // Adapter-dependent (llvmpipe only): left out of snapshots like the times.
