@@ -249,6 +249,13 @@ pub enum Command {
         /// (slow near the horizon: those rays skim the relief for thousands of steps).
         #[arg(long)]
         retry_cut_rays: bool,
+        /// The object every configuration views: the plane, or a cylinder whose top line passes
+        /// through the camera target.
+        #[arg(long, value_enum, default_value_t = ShapeArg::Plane)]
+        shape: ShapeArg,
+        /// Radius of the cylinder (world units, 0.01 to 10⁴).
+        #[arg(long, default_value_t = 2.0, value_parser = radius)]
+        radius: f64,
     },
     /// Run stiff and extreme cases (grazing angles, σ → 0 and 1e6, anisotropy 1e±6, L to 1e12, step
     /// maps, vertical transfer segments, constant images) through core f64, its f32 mirror and the

@@ -356,8 +356,11 @@ fn run(cli: Cli) -> Result<()> {
             march,
             adaptive_rpp,
             retry_cut_rays,
+            shape,
+            radius,
         }) => {
             check_output(&out, true)?;
+            let shape = shape.shape(radius).map_err(anyhow::Error::msg)?;
             let opts = report::Options {
                 size,
                 reference_spp,
@@ -367,6 +370,7 @@ fn run(cli: Cli) -> Result<()> {
                 march: march.march(),
                 adaptive: adaptive_rpp.into_iter().filter(|b| *b > 0.0).collect(),
                 retry_cut_rays,
+                shape,
             };
             let rep = report::run(&preset, &opts)?;
             report::write(&rep, &out)?;

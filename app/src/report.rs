@@ -62,6 +62,8 @@ pub struct Options {
     pub adaptive: Vec<f64>,
     /// Trace cut ground-truth rays again alone (`Renderer::set_retry_cut`).
     pub retry_cut_rays: bool,
+    /// The object every configuration views.
+    pub shape: Shape,
 }
 
 impl Default for Options {
@@ -75,6 +77,7 @@ impl Default for Options {
             march: lodestone_core::scene::march::March::Fast,
             adaptive: ADAPTIVE_RPP.to_vec(),
             retry_cut_rays: false,
+            shape: Shape::Plane,
         }
     }
 }
@@ -137,6 +140,8 @@ pub struct Report {
     pub size: (u32, u32),
     /// Reference rays per pixel.
     pub reference_spp: u32,
+    /// The object viewed: "plane" or "cylinder of radius R".
+    pub object: String,
     /// The configurations.
     pub configs: Vec<ConfigResult>,
 }
@@ -272,7 +277,7 @@ pub fn run_with(
                         fov_deg: 30.0,
                     },
                     light,
-                    shape: Shape::Plane,
+                    shape: opts.shape,
                 };
                 // Ground truth: one progressive accumulation gives every N and the reference.
                 let mut milestones: Vec<u32> =
@@ -415,6 +420,10 @@ pub fn run_with(
         ),
         size: opts.size,
         reference_spp: ref_spp,
+        object: match opts.shape {
+            Shape::Plane => "plane".into(),
+            Shape::Cylinder { radius } => format!("cylinder of radius {radius}"),
+        },
         configs,
     })
 }
@@ -430,7 +439,7 @@ fn adaptive_truth(
     uniform: &[UniformPoint],
 ) -> Result<Vec<AdaptiveResult>> {
     let t = Instant::now();
-    let prediction = evaluator.predict_truth(&scene.camera, opts.size, scene.light);
+    let prediction = evaluator.predict_truth_of(scene.shape, &scene.camera, opts.size, scene.light);
     let predict_ms = t.elapsed().as_secs_f64() * 1e3;
     let mut out = Vec::new();
     let mut tgt = ViewTarget::new(r, opts.size.0, opts.size.1)?;
@@ -493,12 +502,12 @@ pub fn markdown(rep: &Report) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "# Report: {}\n\nAdapter: {}. {}×{} pixels, reference {} rays per pixel. Times: {}.\n\n\
+        "# Report: {}\n\nAdapter: {}. Object: {}. {}×{} pixels, reference {} rays per pixel. Times: {}.\n\n\
          Ground truth at N rays is a prefix of the reference's ray sequence (its RMSE is σ√(1/N − 1/R)); \
          the reference's own noise is the RMSE between its first half and all of it (column `ref. noise`). \
          `RMSE beyond ref. noise` takes the reference's per-pixel noise (from its squared sums) out of each \
          method's mean squared error.\n",
-        rep.preset, rep.adapter, rep.size.0, rep.size.1, rep.reference_spp, rep.timing
+        rep.preset, rep.adapter, rep.object, rep.size.0, rep.size.1, rep.reference_spp, rep.timing
     );
     let names: Vec<String> = rep
         .configs

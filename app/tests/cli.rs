@@ -332,6 +332,64 @@ fn stability_passes_and_reports_json() {
     }
 }
 
+/// `lodestone report --shape cylinder`: the configurations view the cylinder (the report says so),
+/// its adaptive ground truth is predicted there and spends its budget; a bad radius is a usage
+/// error.
+#[test]
+fn report_on_the_cylinder() {
+    let dir = std::env::temp_dir().join(format!("lodestone-report-cyl-{}", std::process::id()));
+    let args = |radius: &str| {
+        vec![
+            "report".to_string(),
+            "--out".into(),
+            dir.to_str().unwrap().into(),
+            "--size".into(),
+            "12x8".into(),
+            "--reference-spp".into(),
+            "16".into(),
+            "--views".into(),
+            "60".into(),
+            "--zooms".into(),
+            "3".into(),
+            "--repeats".into(),
+            "1".into(),
+            "--adaptive-rpp".into(),
+            "4".into(),
+            "--shape".into(),
+            "cylinder".into(),
+            "--radius".into(),
+            radius.into(),
+        ]
+    };
+    let bad = lodestone(&args("-1").iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(
+        bad.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&bad.stderr)
+    );
+    let out = lodestone(&args("1").iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rep: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
+    assert_eq!(rep["object"], "cylinder of radius 1");
+    for c in rep["configs"].as_array().unwrap() {
+        let adaptive = c["adaptive"].as_array().unwrap();
+        assert_eq!(adaptive.len(), 4, "{c}");
+        for a in adaptive {
+            let rays = a["rays_per_pixel"].as_f64().unwrap();
+            // The two-pass plans round each pixel's share: a few percent over the budget.
+            assert!(rays > 0.0 && rays <= 4.0 * 1.05, "{a}");
+            assert!(a["rmse_true"].as_f64().unwrap().is_finite(), "{a}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// `lodestone report` with a tiny budget: every file is written, every configuration and method is
 /// there with finite numbers, and ground truth's error falls as its rays grow.
 #[test]

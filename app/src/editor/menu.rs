@@ -118,7 +118,7 @@ impl EditorApp {
                 }
                 ui.checkbox(&mut self.view.adaptive_truth, "Adaptive ground truth")
                     .on_hover_text(
-                        "Give each ground-truth pixel its own ray count, in proportion to its predicted and measured noise (BSSBH13 Sec. 2.4), instead of the same count everywhere; the plane only (the cylinder stays uniform)",
+                        "Give each ground-truth pixel its own ray count, in proportion to its predicted and measured noise (BSSBH13 Sec. 2.4), instead of the same count everywhere",
                     );
                 ui.separator();
                 ui.weak("Ground truth shows");

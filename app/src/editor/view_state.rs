@@ -95,7 +95,7 @@ pub struct ViewState {
     /// The object: the plane or a cylinder.
     pub shape: Shape,
     /// Ground truth gives each pixel its own ray count from its predicted and measured noise
-    /// (#18 §1; the plane only).
+    /// (#18 §1).
     pub adaptive_truth: bool,
     /// What the ground-truth viewport shows: its image or one of its noise maps.
     pub truth_display: TruthDisplay,

@@ -428,7 +428,7 @@ impl EditorApp {
                 ui,
                 img,
                 &format!(
-                    "no {} for this truth yet: it needs adaptive ground truth on the plane (View menu)",
+                    "no {} for this truth yet: it needs adaptive ground truth (View menu)",
                     d.label()
                 ),
             );

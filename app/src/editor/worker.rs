@@ -17,7 +17,6 @@ use lodestone_core::eval::Evaluator;
 use lodestone_core::material::Material;
 use lodestone_core::material::measured::MeasuredBrdf;
 use lodestone_core::math::sh::Sh9;
-use lodestone_core::scene::shape::Shape;
 use lodestone_render::adaptive_truth::{Progressive, render_progressive};
 use lodestone_render::truth_noise::SampleMoments;
 use lodestone_render::{
@@ -50,8 +49,7 @@ pub struct Request {
     pub truth_spp: u32,
     /// Largest fraction of the full size to render (1 = full resolution).
     pub max_scale: f32,
-    /// Ground truth gives each pixel its own ray count from the predicted and measured noise
-    /// (plane only; the cylinder stays uniform).
+    /// Ground truth gives each pixel its own ray count from the predicted and measured noise.
     pub adaptive_truth: bool,
 }
 
@@ -433,7 +431,7 @@ impl State {
         if !req.modes.contains(&ViewMode::Truth) || req.truth_spp == 0 {
             return Ok(None);
         }
-        if req.adaptive_truth && req.scene.shape == Shape::Plane {
+        if req.adaptive_truth {
             return self.accumulate_adaptive(req, scale, rx, send);
         }
         self.accumulate_truth(req, scale, rx, send)
@@ -615,7 +613,7 @@ const MAX_RAYS_FACTOR: u32 = 8;
 fn predicted_deviation(prepared: &Evaluator, scene: &Scene, (w, h): (u32, u32)) -> Vec<f64> {
     let f = w.max(h).div_ceil(PREDICT_SIDE).max(1);
     let (sw, sh) = (w.div_ceil(f).max(1), h.div_ceil(f).max(1));
-    let pred = prepared.predict_truth(&scene.camera, (sw, sh), scene.light);
+    let pred = prepared.predict_truth_of(scene.shape, &scene.camera, (sw, sh), scene.light);
     let mut out = Vec::with_capacity((w * h) as usize);
     for y in 0..h {
         let sy = (u64::from(y) * u64::from(sh) / u64::from(h.max(1))) as usize;

@@ -2,6 +2,7 @@
 //! marched with the rate bound of [`crate::scene::cylinder`]), and the analytic views in the tangent
 //! plane where the ray meets the mean cylinder.
 
+use crate::driver::footprint::Footprint;
 use crate::eval::{Evaluator, Method};
 use crate::microfacet::slopes::normal_of;
 use crate::scene::camera::Camera;
@@ -75,23 +76,36 @@ impl Evaluator {
         (width, height): (u32, u32),
         wi: DVec3,
     ) -> [f64; 3] {
+        match self.cylinder_query(r, camera, p, (width, height), wi) {
+            Some((o, d, wi, fp, m)) => self.pixel_in_frame(method, o, d, wi, fp, &m),
+            None => [0.0; 3],
+        }
+    }
+
+    /// Where [`Evaluator::cylinder_pixel`] evaluates pixel centre `p`: the ray's origin and
+    /// direction and the light in the tangent frame where it meets the mean cylinder, the pixel's
+    /// footprint on that plane, and the frame (its axes in the world as columns). None where the
+    /// ray misses the cylinder or has no footprint there.
+    pub fn cylinder_query(
+        &self,
+        r: f64,
+        camera: &Camera,
+        p: DVec2,
+        (width, height): (u32, u32),
+        wi: DVec3,
+    ) -> Option<(DVec3, DVec3, DVec3, Footprint, DMat3)> {
         let camera = &self.surface.clear_cylinder_camera(camera, r);
         let ray = camera.ray(p, width, height);
-        let Some((t, _)) = intersect(r, r, ray.origin, ray.dir) else {
-            return [0.0; 3];
-        };
+        let (t, _) = intersect(r, r, ray.origin, ray.dir)?;
         let hit = ray.origin + ray.dir * t;
         let (u, v, _, phi) = to_surface(r, hit);
         let fr = frame(phi);
-        let Some(cov) = camera.tangent_footprint(p, width, height, hit, fr) else {
-            return [0.0; 3];
-        };
+        let cov = camera.tangent_footprint(p, width, height, hit, fr)?;
         let uv = DVec2::new(u, v);
         let o = to_tangent(ray.origin, hit, uv, fr);
         let d = local(ray.dir, fr);
-        let fp = crate::driver::footprint::Footprint { cov };
         let m = DMat3::from_cols(fr.0, fr.1, fr.2);
-        self.pixel_in_frame(method, o, d, local(wi, fr), fp, &m)
+        Some((o, d, local(wi, fr), Footprint { cov }, m))
     }
 }
 
