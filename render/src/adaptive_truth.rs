@@ -8,7 +8,7 @@
 //! ([`SamplingPlan::refine`]: cells whose measured residual from the prediction is not smooth are
 //! shaded whole) with the rest. Uniform sampling is `Renderer::draw` with the same total.
 
-use crate::truth_noise::SampleMoments;
+use crate::truth_noise::{SampleMoments, TruthEstimate};
 use crate::{LinearImage, RenderError, Renderer, Scene, ViewTarget};
 use lodestone_core::eval::sampling_plan::SamplingPlan;
 use lodestone_core::eval::truth_prediction::TruthPrediction;
@@ -254,21 +254,32 @@ pub fn progressive_counts(
 
 /// Per pixel of a truth image and its squared sums: (rays, sample variance of their luminance),
 /// the measurement [`pixel_deviations`] pools with the prediction.
+/// ([`TruthEstimate::pixel`]'s variance of the mean times n; 0 below two rays, and for sizes
+/// that do not match.)
 pub fn luminance_variances(image: &LinearImage, moments: &SampleMoments) -> Vec<(u32, f64)> {
+    let Some(est) = TruthEstimate::new(image, moments) else {
+        return Vec::new();
+    };
+    let w = image.width.max(1);
     image
         .pixels
         .iter()
-        .zip(&moments.sum_sq)
-        .map(|(p, q)| {
-            let n = f64::from(p[3]);
-            let s = crate::truth_noise::luminance([0, 1, 2].map(|k| f64::from(p[k])));
-            let var = if n >= 2.0 {
-                ((f64::from(q[3]) - s * s / n) / (n - 1.0)).max(0.0)
-            } else {
-                0.0
-            };
-            (n.max(0.0) as u32, var)
+        .enumerate()
+        .map(|(i, p)| {
+            let n = f64::from(p[3]).max(0.0);
+            let v = est.pixel(i as u32 % w, i as u32 / w).var_mean_y * n;
+            (n as u32, if v.is_finite() { v } else { 0.0 })
         })
+        .collect()
+}
+
+/// One more ray's cost per pixel, `1 + work/rays` (one unit for the ray's setup and shading),
+/// from a target's work ([`ViewTarget::read_work`]) and the rays each pixel has: what the
+/// cost-aware plan weighs, and the editor's cost map.
+pub fn ray_costs(work: &[u32], rays: &[u32]) -> Vec<f64> {
+    work.iter()
+        .zip(rays)
+        .map(|(w, n)| 1.0 + f64::from(*w) / f64::from((*n).max(1)))
         .collect()
 }
 
@@ -347,13 +358,7 @@ pub fn render_progressive(
         }
         measured = luminance_variances(&target.read(renderer)?, &target.read_moments(renderer)?);
         if plan.cost_aware {
-            // Cost per ray, plus one unit for the ray's setup and shading.
-            cost = target
-                .read_work(renderer)?
-                .iter()
-                .zip(&have)
-                .map(|(w, n)| 1.0 + f64::from(*w) / f64::from((*n).max(1)))
-                .collect();
+            cost = ray_costs(&target.read_work(renderer)?, &have);
         }
         budget = (budget * 2.0).min(goal_rpp);
     }
@@ -447,6 +452,25 @@ mod tests {
         assert_eq!(c, vec![1, 1]);
         let c = progressive_counts(&[1e300, 1e-300], &[1e300, 1e-300], &[], 1e6, u32::MAX);
         assert!(c.iter().all(|&r| r >= 1));
+    }
+
+    #[test]
+    fn measured_variances_and_costs_per_pixel() {
+        // Pixel 0: two grey rays of luminance 0 and 1 (s² = 0.5); pixel 1: one ray (unknown: 0).
+        let image = LinearImage {
+            width: 2,
+            height: 1,
+            pixels: vec![[1.0, 1.0, 1.0, 2.0], [0.5, 0.5, 0.5, 1.0]],
+        };
+        let moments = SampleMoments {
+            width: 2,
+            height: 1,
+            sum_sq: vec![[1.0; 4], [0.25; 4]],
+        };
+        let v = luminance_variances(&image, &moments);
+        assert_eq!((v[0].0, v[1]), (2, (1, 0.0)));
+        assert!((v[0].1 - 0.5).abs() < 1e-6, "{v:?}");
+        assert_eq!(ray_costs(&[30, 0, 7], &[3, 0, 1]), vec![11.0, 1.0, 8.0]);
     }
 
     #[test]

@@ -210,6 +210,39 @@ pub struct ViewTarget {
 }
 
 /// Map a finished `MAP_READ` buffer and copy it out as 32-bit words (waits for the GPU).
+/// A storage buffer the view shader writes and the CPU can clear and read back.
+fn readable_storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size,
+        usage: wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_SRC
+            | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// The first `bytes` of `src` as u32 words (waits for the GPU).
+fn read_words(
+    renderer: &Renderer,
+    src: &wgpu::Buffer,
+    bytes: u64,
+) -> Result<Vec<u32>, RenderError> {
+    let device = &renderer.ctx.device;
+    let readback = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: bytes,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+        label: Some("readback"),
+    });
+    enc.copy_buffer_to_buffer(src, 0, &readback, 0, bytes);
+    renderer.ctx.queue.submit([enc.finish()]);
+    map_words(renderer, &readback)
+}
+
 fn map_words(renderer: &Renderer, readback: &wgpu::Buffer) -> Result<Vec<u32>, RenderError> {
     let slice = readback.slice(..);
     let (tx, rx) = std::sync::mpsc::channel();
@@ -270,22 +303,8 @@ impl ViewTarget {
                 ),
             });
         }
-        let accum = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("accumulation"),
-            size: bytes,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_SRC
-                | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let moments = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("truth moments"),
-            size: bytes,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_SRC
-                | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let accum = readable_storage(device, "accumulation", bytes);
+        let moments = readable_storage(device, "truth moments", bytes);
         let view = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("view params"),
             size: std::mem::size_of::<ViewParams>() as u64,
@@ -293,22 +312,12 @@ impl ViewTarget {
             mapped_at_creation: false,
         });
         let (order, scratch) = plan_buffers(device, 1);
-        let cut = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("cut loops"),
-            size: 16,
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_SRC
-                | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let work = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("work per pixel"),
-            size: (u64::from(width) * u64::from(height) * 4).max(16),
-            usage: wgpu::BufferUsages::STORAGE
-                | wgpu::BufferUsages::COPY_SRC
-                | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let cut = readable_storage(device, "cut loops", 16);
+        let work = readable_storage(
+            device,
+            "work per pixel",
+            (u64::from(width) * u64::from(height) * 4).max(16),
+        );
         Ok(Self {
             width,
             height,
@@ -338,19 +347,7 @@ impl ViewTarget {
     /// of its values are unreliable. Real GPUs have no such cap: 0 there, bar a march that ran out
     /// of its 20000 steps.
     pub fn cut_count(&self, renderer: &Renderer) -> Result<u32, RenderError> {
-        let device = &renderer.ctx.device;
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size: 16,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("readback"),
-        });
-        enc.copy_buffer_to_buffer(&self.cut, 0, &readback, 0, 16);
-        renderer.ctx.queue.submit([enc.finish()]);
-        let words = map_words(renderer, &readback)?;
+        let words = read_words(renderer, &self.cut, 16)?;
         Ok(words.first().copied().unwrap_or(0))
     }
 
@@ -361,20 +358,7 @@ impl ViewTarget {
     /// counts). Row-major; rays traced again after a loop cut are not counted.
     pub fn read_work(&self, renderer: &Renderer) -> Result<Vec<u32>, RenderError> {
         let n = (self.width as usize) * (self.height as usize);
-        let bytes = (n as u64 * 4).max(16);
-        let device = &renderer.ctx.device;
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size: bytes,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("readback"),
-        });
-        enc.copy_buffer_to_buffer(&self.work, 0, &readback, 0, bytes);
-        renderer.ctx.queue.submit([enc.finish()]);
-        let mut words = map_words(renderer, &readback)?;
+        let mut words = read_words(renderer, &self.work, (n as u64 * 4).max(16))?;
         words.truncate(n);
         Ok(words)
     }

@@ -17,7 +17,7 @@ use lodestone_core::eval::Evaluator;
 use lodestone_core::material::Material;
 use lodestone_core::material::measured::MeasuredBrdf;
 use lodestone_core::math::sh::Sh9;
-use lodestone_render::adaptive_truth::{Progressive, render_progressive};
+use lodestone_render::adaptive_truth::{Progressive, ray_costs, render_progressive};
 use lodestone_render::truth_noise::SampleMoments;
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
@@ -501,7 +501,7 @@ impl State {
                     let image = target.read(renderer)?;
                     let moments = target.read_moments(renderer)?;
                     let cut_rays = target.cut_count(renderer)?;
-                    let cost = ray_costs(&target.read_work(renderer)?, rays);
+                    let cost = costs_f32(&target.read_work(renderer)?, rays);
                     send(Event::Frame(Frame {
                         generation: req.generation,
                         mode: ViewMode::Truth,
@@ -574,7 +574,7 @@ impl State {
                         samples: target.samples,
                         rays: None,
                         predicted_sd: None,
-                        cost: Some(Arc::new(ray_costs(
+                        cost: Some(Arc::new(costs_f32(
                             &work,
                             &vec![target.samples; work.len()],
                         ))),
@@ -625,13 +625,11 @@ fn predicted_deviation(prepared: &Evaluator, scene: &Scene, (w, h): (u32, u32)) 
     out
 }
 
-/// One more ray's cost per pixel from the target's work (`ViewTarget::read_work`) over the
-/// pixel's rays: `1 + work/rays` (1 for the ray's setup and shading), as
-/// `render_progressive`'s cost-aware plan weighs it.
-fn ray_costs(work: &[u32], rays: &[u32]) -> Vec<f32> {
-    work.iter()
-        .zip(rays)
-        .map(|(w, n)| (1.0 + f64::from(*w) / f64::from((*n).max(1))) as f32)
+/// [`ray_costs`] as the frames carry it.
+fn costs_f32(work: &[u32], rays: &[u32]) -> Vec<f32> {
+    ray_costs(work, rays)
+        .into_iter()
+        .map(|c| c as f32)
         .collect()
 }
 
