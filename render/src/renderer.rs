@@ -431,20 +431,8 @@ impl ViewTarget {
         renderer: &Renderer,
         buffer: &wgpu::Buffer,
     ) -> Result<Vec<[f32; 4]>, RenderError> {
-        let device = &renderer.ctx.device;
         let size = u64::from(self.width) * u64::from(self.height) * BYTES_PER_PIXEL;
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let mut enc = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("readback"),
-        });
-        enc.copy_buffer_to_buffer(buffer, 0, &readback, 0, size);
-        renderer.ctx.queue.submit([enc.finish()]);
-        let words = map_words(renderer, &readback)?;
+        let words = read_words(renderer, buffer, size)?;
         let floats: &[f32] = bytemuck::cast_slice(&words);
         Ok(floats
             .chunks_exact(4)
