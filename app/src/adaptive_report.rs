@@ -32,10 +32,17 @@ pub enum Strategy {
         /// Shares divided by √(measured cost per ray).
         cost_aware: bool,
     },
+    /// The same rays everywhere (`progressive: false`) or progressive counts, then each pixel
+    /// pools the rays of the window around it that ICI chooses
+    /// ([`lodestone_render::adaptive_truth::reconstruct_truth`]).
+    Reconstructed {
+        /// Progressive counts rather than uniform rays.
+        progressive: bool,
+    },
 }
 
 /// The adaptive strategies compared, by name.
-pub const STRATEGIES: [(&str, Strategy); 4] = [
+pub const STRATEGIES: [(&str, Strategy); 6] = [
     ("ray counts", Strategy::TwoPass(1)),
     ("lattice 4, refined", Strategy::TwoPass(4)),
     (
@@ -45,6 +52,14 @@ pub const STRATEGIES: [(&str, Strategy); 4] = [
     (
         "progressive, cost-aware",
         Strategy::Progressive { cost_aware: true },
+    ),
+    (
+        "uniform, reconstructed",
+        Strategy::Reconstructed { progressive: false },
+    ),
+    (
+        "progressive, reconstructed",
+        Strategy::Reconstructed { progressive: true },
     ),
 ];
 
@@ -99,13 +114,14 @@ impl AdaptiveResult {
 }
 
 /// RMSE of `img` against the true image, from its error against `reference` and the
-/// reference's own noise: `+σ²/R` where `prefix(p)` (the pixel holds the first rays of the
-/// reference's sequence), `−σ²/R` elsewhere; clamped at 0.
-pub fn rmse_true(
-    img: &LinearImage,
-    reference: &TruthEstimate,
-    prefix: &dyn Fn(usize) -> bool,
-) -> f64 {
+/// reference's own noise. Pixel p's value is `w_p` times a prefix of the reference's ray sequence
+/// at p (its own first rays) plus what is independent of the reference there (other pixels'
+/// rays, or an interpolation): `x̂ = w_p·x̄_n + (1 − w_p)·y`, so `Cov(x̂, x̂_R) = w_p·σ²/R` and
+/// `E[(x̂ − x̂_R)²] = E[(x̂ − μ)²] + σ²/R − 2·w_p·σ²/R`. The true squared error is therefore the
+/// squared error against the reference `+(2w_p − 1)·σ²/R`: `+σ²/R` for a prefix (`w_p = 1`),
+/// `−σ²/R` for an interpolated pixel (`w_p = 0`). `own(p)` gives `w_p` (clamped to [0, 1]);
+/// the result is clamped at 0.
+pub fn rmse_true(img: &LinearImage, reference: &TruthEstimate, own: &dyn Fn(usize) -> f64) -> f64 {
     let r = reference.image();
     let (w, h) = (r.width, r.height);
     let (mut sum, mut n) = (0.0, 0.0f64);
@@ -114,7 +130,12 @@ pub fn rmse_true(
             let p = (y * w + x) as usize;
             let a = img.rgb(x, y).map(f64::from);
             let e = reference.pixel(x, y);
-            let sign = if prefix(p) { 1.0 } else { -1.0 };
+            let w_own = own(p);
+            let sign = if w_own.is_finite() {
+                2.0 * w_own.clamp(0.0, 1.0) - 1.0
+            } else {
+                -1.0
+            };
             for k in 0..3 {
                 let v = if e.var_mean[k].is_finite() {
                     e.var_mean[k]
@@ -280,7 +301,9 @@ pub fn chart(
             .collect();
         series.push((
             format!("adaptive, {strategy}"),
-            ["#d62728", "#1f77b4", "#2ca02c", "#9467bd"][i % 4],
+            [
+                "#d62728", "#1f77b4", "#2ca02c", "#9467bd", "#ff7f0e", "#17becf",
+            ][i % 6],
             pts,
             true,
         ));

@@ -25,6 +25,7 @@ use crate::cielab::delta_e76;
 use crate::preset_io::Resolved;
 use anyhow::{Context, Result};
 use glam::DVec3;
+use lodestone_core::eval::adaptive_window::WindowOptions;
 use lodestone_core::eval::sampling_plan::SamplingPlan;
 use lodestone_core::microfacet::effective_height::HeightFilter;
 use lodestone_core::microfacet::masking_shadowing::Correlation;
@@ -32,7 +33,8 @@ use lodestone_core::scene::camera::Camera;
 use lodestone_core::scene::direction::direction;
 use lodestone_core::scene::shape::Shape;
 use lodestone_render::adaptive_truth::{
-    AdaptiveOptions, AdaptiveTruth, Progressive, render_adaptive, render_progressive,
+    AdaptiveOptions, AdaptiveTruth, Progressive, reconstruct_truth, render_adaptive,
+    render_progressive,
 };
 use lodestone_render::truth_noise::{BlockErrors, TruthEstimate};
 use lodestone_render::{
@@ -379,7 +381,7 @@ pub fn run_with(
                     .filter(|(n, _)| TRUTH_SPP.contains(n) && *n < ref_spp)
                     .map(|(n, img)| UniformPoint {
                         spp: *n,
-                        rmse_true: rmse_true(img, &reference_est, &|_| true),
+                        rmse_true: rmse_true(img, &reference_est, &|_| 1.0),
                         ms: ray_ms * f64::from(*n),
                     })
                     .collect();
@@ -449,37 +451,70 @@ fn adaptive_truth(
             let max_rays = opts.reference_spp.max(2) / 2;
             // One run, as the uniform truth's milestones: its passes are long enough to time once.
             let t = Instant::now();
-            let a = match how {
+            let (size_w, size_h) = (opts.size.0 as usize, opts.size.1 as usize);
+            let progressive = |cost_aware: bool, tgt: &mut ViewTarget| {
+                let plan = Progressive {
+                    predicted: &prediction.sd,
+                    rays_per_pixel: budget,
+                    max_rays,
+                    cost_aware,
+                };
+                render_progressive(r, tgt, gm, scene, plan, |_, _, _| Ok(true))
+            };
+            let (a, own): (AdaptiveTruth, Vec<f64>) = match how {
                 Strategy::TwoPass(step) => {
                     let a_opts = AdaptiveOptions {
                         rays_per_pixel: budget,
                         step,
                         max_rays,
                     };
-                    render_adaptive(r, &mut tgt, gm, scene, &prediction, a_opts)?
+                    let a = render_adaptive(r, &mut tgt, gm, scene, &prediction, a_opts)?;
+                    let own = a.plan.rays.iter().map(|n| f64::from(u8::from(*n > 0))).collect();
+                    (a, own)
                 }
                 Strategy::Progressive { cost_aware } => {
-                    let plan = Progressive {
-                        predicted: &prediction.sd,
-                        rays_per_pixel: budget,
-                        max_rays,
-                        cost_aware,
+                    let rays = progressive(cost_aware, &mut tgt)?;
+                    let own = vec![1.0; rays.len()];
+                    let plan = SamplingPlan {
+                        width: size_w,
+                        height: size_h,
+                        step: 1,
+                        rays,
                     };
-                    let rays =
-                        render_progressive(r, &mut tgt, gm, scene, plan, |_, _, _| Ok(true))?;
-                    AdaptiveTruth {
-                        image: tgt.read(r)?,
-                        plan: SamplingPlan {
-                            width: opts.size.0 as usize,
-                            height: opts.size.1 as usize,
-                            step: 1,
-                            rays,
+                    (
+                        AdaptiveTruth {
+                            image: tgt.read(r)?,
+                            plan,
                         },
-                    }
+                        own,
+                    )
+                }
+                Strategy::Reconstructed { progressive: prog } => {
+                    let rays = if prog {
+                        progressive(false, &mut tgt)?
+                    } else {
+                        let rays = vec![(budget.round() as u32).clamp(1, max_rays.max(1)); size_w * size_h];
+                        tgt.reset();
+                        r.draw_planned(&mut tgt, gm, scene, &rays);
+                        rays
+                    };
+                    let (image, windows) = reconstruct_truth(
+                        &tgt.read(r)?,
+                        &tgt.read_moments(r)?,
+                        &prediction.sd,
+                        WindowOptions::default(),
+                    );
+                    let plan = SamplingPlan {
+                        width: size_w,
+                        height: size_h,
+                        step: 1,
+                        rays,
+                    };
+                    (AdaptiveTruth { image, plan }, windows.own_weight)
                 }
             };
             let ms = t.elapsed().as_secs_f64() * 1e3;
-            let err = rmse_true(&a.image, reference, &|p| a.plan.rays[p] > 0);
+            let err = rmse_true(&a.image, reference, &|p| own.get(p).copied().unwrap_or(0.0));
             out.push(AdaptiveResult {
                 strategy: strategy.into(),
                 budget,

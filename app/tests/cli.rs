@@ -379,7 +379,7 @@ fn report_on_the_cylinder() {
     assert_eq!(rep["object"], "cylinder of radius 1");
     for c in rep["configs"].as_array().unwrap() {
         let adaptive = c["adaptive"].as_array().unwrap();
-        assert_eq!(adaptive.len(), 4, "{c}");
+        assert_eq!(adaptive.len(), 6, "{c}");
         for a in adaptive {
             let rays = a["rays_per_pixel"].as_f64().unwrap();
             // The two-pass plans round each pixel's share: a few percent over the budget.
@@ -432,11 +432,11 @@ fn report_writes_tables_and_charts() {
     let configs = rep["configs"].as_array().unwrap();
     assert_eq!(configs.len(), 2 * 3);
     for c in configs {
-        // Adaptive ground truth (#18 §1): four strategies at the default budgets 4, 16, 64, each
+        // Adaptive ground truth (#18 §1): six strategies at the default budgets 4, 16, 64, each
         // capped at half the reference's 16 rays a pixel.
         assert!(c["reference_cut_rays"].as_u64().is_some(), "{c}");
         let adaptive = c["adaptive"].as_array().unwrap();
-        assert_eq!(adaptive.len(), 4 * 3, "{c}");
+        assert_eq!(adaptive.len(), 6 * 3, "{c}");
         for a in adaptive {
             let rays = a["rays_per_pixel"].as_f64().unwrap();
             assert!(rays > 0.0 && rays <= 8.0 + 1e-9, "{a}");

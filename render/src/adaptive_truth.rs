@@ -10,6 +10,9 @@
 
 use crate::truth_noise::{SampleMoments, TruthEstimate};
 use crate::{LinearImage, RenderError, Renderer, Scene, ViewTarget};
+use lodestone_core::eval::adaptive_window::{
+    WindowOptions, WindowReconstruction, WindowSample, reconstruct,
+};
 use lodestone_core::eval::sampling_plan::SamplingPlan;
 use lodestone_core::eval::truth_prediction::TruthPrediction;
 
@@ -281,6 +284,51 @@ pub fn ray_costs(work: &[u32], rays: &[u32]) -> Vec<f64> {
         .zip(rays)
         .map(|(w, n)| 1.0 + f64::from(*w) / f64::from((*n).max(1)))
         .collect()
+}
+
+/// A ground truth (`image`, its squared sums `moments`) reconstructed over windows chosen per pixel
+/// by the intersection of confidence intervals
+/// ([`lodestone_core::eval::adaptive_window`], [BSSBH13 Sec. 3]): each pixel's value pools the rays
+/// of the largest window around it whose mean stays within its noise. One ray's variance per pixel
+/// is its measured sample variance pooled with the prediction `predicted` ([`pixel_deviations`];
+/// a `predicted` of the wrong size counts as 0, which shrinks the measured variance and so the
+/// windows). Returns the image (weight 1) and the windows.
+pub fn reconstruct_truth(
+    image: &LinearImage,
+    moments: &SampleMoments,
+    predicted: &[f64],
+    options: WindowOptions,
+) -> (LinearImage, WindowReconstruction) {
+    let n = (image.width as usize) * (image.height as usize);
+    let predicted = if predicted.len() == n {
+        predicted.to_vec()
+    } else {
+        vec![0.0; n]
+    };
+    let deviation = pixel_deviations(&predicted, &luminance_variances(image, moments));
+    let samples: Vec<WindowSample> = (0..n.min(image.pixels.len()))
+        .map(|p| WindowSample {
+            rays: f64::from(image.pixels[p][3]),
+            mean: rgb(image, p),
+            ray_var: deviation[p] * deviation[p],
+        })
+        .collect();
+    let r = reconstruct(
+        image.width as usize,
+        image.height as usize,
+        &samples,
+        options,
+    );
+    let out = LinearImage {
+        width: image.width,
+        height: image.height,
+        pixels: r
+            .rgb
+            .iter()
+            .map(|c| [c[0] as f32, c[1] as f32, c[2] as f32, 1.0])
+            .collect(),
+    };
+    (out, r)
 }
 
 /// What a progressive adaptive ground truth plans with ([`render_progressive`]).

@@ -1,7 +1,7 @@
 //! The render worker's side of the window: requests for what the views need, frames uploaded as
 //! textures as they arrive, and error heat maps against the ground truth.
 
-use super::truth_maps::{truth_heat, truth_values};
+use super::truth_maps::truth_map;
 use super::worker::{Event, Frame, Request};
 use super::{DeviceStatus, EditorApp, ErrorShown, Shown, TruthHeatShown};
 use lodestone_render::error_map::{error_heat, error_stats, heat_gradient};
@@ -124,11 +124,10 @@ impl EditorApp {
         if self.truth_heat.as_ref().is_some_and(|h| h.from == from) {
             return;
         }
-        let Some(values) = truth_values(f, display) else {
+        let Some(heat) = truth_map(f, display) else {
             self.truth_heat = None;
             return;
         };
-        let heat = truth_heat(&values, f.image.width, f.image.height);
         let img = heat.image.to_srgb8();
         let color = egui::ColorImage::from_rgba_unmultiplied(
             [img.width() as usize, img.height() as usize],

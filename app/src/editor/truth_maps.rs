@@ -1,9 +1,12 @@
 //! The ground truth's noise as heat maps (#18 §1): the standard error of each pixel's mean, the
-//! predicted deviation of one ray that adaptive sampling plans with, and the rays each pixel has.
+//! predicted deviation of one ray that adaptive sampling plans with, the rays each pixel has, and
+//! the truth reconstructed over windows flat within its noise, with those windows' radii.
 
 use super::view_state::TruthDisplay;
 use super::worker::Frame;
+use lodestone_core::eval::adaptive_window::{WindowOptions, WindowReconstruction};
 use lodestone_render::LinearImage;
+use lodestone_render::adaptive_truth::reconstruct_truth;
 use lodestone_render::error_map::heat_gradient;
 use lodestone_render::truth_noise::TruthEstimate;
 
@@ -18,13 +21,45 @@ pub(super) struct TruthHeat {
 /// Dark grey: a pixel whose value is unknown (one ray, or none).
 const UNKNOWN: [f32; 4] = [0.02, 0.02, 0.02, 1.0];
 
-/// Per pixel of `frame` (a ground truth), the value `display` shows; `None` for the image, or
+/// `frame` (a ground truth) reconstructed over windows ([`reconstruct_truth`]); the prediction
+/// pools each pixel's measured variance where the frame has one (adaptive truth). `None` without
+/// moments.
+fn reconstruction(frame: &Frame) -> Option<(LinearImage, WindowReconstruction)> {
+    let predicted: Vec<f64> = frame
+        .predicted_sd
+        .as_deref()
+        .map(|sd| sd.iter().map(|v| f64::from(*v)).collect())
+        .unwrap_or_default();
+    Some(reconstruct_truth(
+        &frame.image,
+        frame.moments.as_deref()?,
+        &predicted,
+        WindowOptions::default(),
+    ))
+}
+
+/// What the truth viewport shows instead of its image: a heat map of [`truth_values`], or the
+/// reconstructed image (with a scale of 0). `None` for the image, or where the frame lacks what
+/// `display` needs.
+pub(super) fn truth_map(frame: &Frame, display: TruthDisplay) -> Option<TruthHeat> {
+    if display == TruthDisplay::Reconstructed {
+        return reconstruction(frame).map(|(image, _)| TruthHeat { image, max: 0.0 });
+    }
+    let values = truth_values(frame, display)?;
+    Some(truth_heat(&values, frame.image.width, frame.image.height))
+}
+
+/// Per pixel of `frame` (a ground truth), the value `display` shows; `None` for the images, or
 /// where the frame lacks it (no moments, or no prediction for a uniform truth's deviation).
 pub(super) fn truth_values(frame: &Frame, display: TruthDisplay) -> Option<Vec<Option<f64>>> {
     let (w, h) = (frame.image.width, frame.image.height);
     let n = (w * h) as usize;
     match display {
-        TruthDisplay::Image => None,
+        TruthDisplay::Image | TruthDisplay::Reconstructed => None,
+        TruthDisplay::WindowRadius => {
+            let (_, r) = reconstruction(frame)?;
+            Some(r.radius.iter().map(|v| Some(f64::from(*v))).collect())
+        }
         TruthDisplay::StandardError => {
             let est = TruthEstimate::new(&frame.image, frame.moments.as_deref()?)?;
             Some(
@@ -167,5 +202,26 @@ mod tests {
         let unknown = truth_heat(&[None, Some(f64::NAN)], 2, 1);
         assert_eq!(unknown.image.pixels, vec![UNKNOWN; 2]);
         assert_eq!(unknown.max, 0.0);
+    }
+
+    #[test]
+    fn the_reconstruction_pools_flat_pixels_and_keeps_an_outlier() {
+        // Five grey pixels of 4 rays (s² = 1/15 each): four at 0.5, the last at 5. The flat four
+        // pool over the widest window that leaves out the outlier (radius 3 from pixel 0); the
+        // outlier keeps its own rays.
+        let mut pixels = vec![[2.0, 2.0, 2.0, 4.0]; 4];
+        pixels.push([20.0, 20.0, 20.0, 4.0]);
+        let mut sum_sq = vec![[1.2; 4]; 4];
+        sum_sq.push([100.2; 4]);
+        let f = frame(pixels, sum_sq, Some(vec![4; 5]));
+        let radius = truth_values(&f, TruthDisplay::WindowRadius).unwrap();
+        assert_eq!(radius[0], Some(3.0), "{radius:?}");
+        assert_eq!(radius[4], Some(0.0), "{radius:?}");
+        let img = truth_map(&f, TruthDisplay::Reconstructed).unwrap().image;
+        for p in 0..4 {
+            assert!((img.pixels[p][0] - 0.5).abs() < 1e-5, "{:?}", img.pixels);
+        }
+        assert!((img.pixels[4][0] - 5.0).abs() < 1e-5, "{:?}", img.pixels);
+        assert!(truth_values(&f, TruthDisplay::Reconstructed).is_none());
     }
 }

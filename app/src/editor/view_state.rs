@@ -115,16 +115,24 @@ pub enum TruthDisplay {
     Rays,
     /// What one more ray costs per pixel (march steps plus eights of waves summed).
     Cost,
+    /// The image with each pixel pooled over the window around it that is flat within the
+    /// truth's noise (intersection of confidence intervals, [BSSBH13 Sec. 3]).
+    Reconstructed,
+    /// The radius of that window per pixel: the scale below which the truth is flat, as
+    /// measured by its rays.
+    WindowRadius,
 }
 
 impl TruthDisplay {
     /// Every choice.
-    pub const ALL: [Self; 5] = [
+    pub const ALL: [Self; 7] = [
         Self::Image,
+        Self::Reconstructed,
         Self::StandardError,
         Self::PredictedDeviation,
         Self::Rays,
         Self::Cost,
+        Self::WindowRadius,
     ];
 
     /// Menu and title text.
@@ -135,6 +143,8 @@ impl TruthDisplay {
             Self::PredictedDeviation => "predicted ray deviation",
             Self::Rays => "rays per pixel",
             Self::Cost => "cost per ray",
+            Self::Reconstructed => "image, reconstructed",
+            Self::WindowRadius => "reconstruction window radius",
         }
     }
 
@@ -153,6 +163,12 @@ impl TruthDisplay {
             }
             Self::Cost => {
                 "What one more ground-truth ray costs in each pixel: march steps plus eights of waves summed, averaged over its rays (rays that skim the relief toward the horizon march longest)"
+            }
+            Self::Reconstructed => {
+                "The ground truth with each pixel pooled over the largest square window around it whose mean stays within the truth's own noise (intersection of confidence intervals, Γ = 2, radius ≤ 8; BSSBH13 Sec. 3): far less noise where the image is flat, edges kept. Chosen from the rays alone, never from the filtered model; error maps still use the unpooled truth"
+            }
+            Self::WindowRadius => {
+                "The radius of each pixel's reconstruction window: the scale, in pixels, over which the truth is flat within its noise (its measured bandwidth is about 1/(2r + 1) cycles per pixel); 0 keeps the pixel's own rays"
             }
         }
     }

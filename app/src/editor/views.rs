@@ -424,14 +424,13 @@ impl EditorApp {
         } else if let Some(d) = truth_map
             && tex.is_some()
         {
-            note(
-                ui,
-                img,
-                &format!(
-                    "no {} for this truth yet: it needs adaptive ground truth (View menu)",
-                    d.label()
-                ),
-            );
+            let why = match d {
+                TruthDisplay::PredictedDeviation | TruthDisplay::Cost => {
+                    ": it needs adaptive ground truth (View menu)"
+                }
+                _ => "",
+            };
+            note(ui, img, &format!("no {} for this truth yet{why}", d.label()));
         }
         if show_error {
             self.legend(ui, img);
@@ -575,6 +574,11 @@ fn truth_legend(ui: &Ui, img: Rect, display: TruthDisplay, max: f64) {
             format!("{max:.3}"),
             "standard error of the mean luminance (grey: under 2 rays)",
         ),
+        TruthDisplay::WindowRadius => (
+            format!("{max:.0}"),
+            "window radius, pixels (flat within the truth's noise)",
+        ),
+        TruthDisplay::Image | TruthDisplay::Reconstructed => return,
         _ => (format!("{max:.3}"), "σ̂ of one ray's luminance"),
     };
     heat_bar(ui, img, &top, unit);

@@ -29,6 +29,7 @@
 //! ([`pixel`], [`cylinder`]); the material compiled once into closed enums ([`compiled`]), the
 //! shading inputs every method shares ([`shading`]) and the footprint statistics ([`query`]).
 
+pub mod adaptive_window;
 pub mod compiled;
 pub mod cylinder;
 pub mod evaluator;
