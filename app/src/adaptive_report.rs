@@ -24,7 +24,7 @@ pub const ADAPTIVE_RPP: [f64; 3] = [4.0, 16.0, 64.0];
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Strategy {
     /// [`lodestone_render::adaptive_truth::render_adaptive`]'s two passes on a lattice of this
-    /// step (1: ray counts only).
+    /// step (1: ray counts only, superseded by the progressive counts and no longer reported).
     TwoPass(usize),
     /// [`lodestone_render::adaptive_truth::render_progressive`]'s doubling rounds (the editor's),
     /// cost-aware or not.
@@ -38,12 +38,13 @@ pub enum Strategy {
     Reconstructed {
         /// Progressive counts rather than uniform rays.
         progressive: bool,
+        /// The prediction's luminance refuses windows it predicts biased.
+        guided: bool,
     },
 }
 
 /// The adaptive strategies compared, by name.
 pub const STRATEGIES: [(&str, Strategy); 6] = [
-    ("ray counts", Strategy::TwoPass(1)),
     ("lattice 4, refined", Strategy::TwoPass(4)),
     (
         "progressive counts",
@@ -55,11 +56,24 @@ pub const STRATEGIES: [(&str, Strategy); 6] = [
     ),
     (
         "uniform, reconstructed",
-        Strategy::Reconstructed { progressive: false },
+        Strategy::Reconstructed {
+            progressive: false,
+            guided: false,
+        },
     ),
     (
-        "progressive, reconstructed",
-        Strategy::Reconstructed { progressive: true },
+        "uniform, guided reconstruction",
+        Strategy::Reconstructed {
+            progressive: false,
+            guided: true,
+        },
+    ),
+    (
+        "progressive, guided reconstruction",
+        Strategy::Reconstructed {
+            progressive: true,
+            guided: true,
+        },
     ),
 ];
 

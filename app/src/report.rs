@@ -443,6 +443,7 @@ fn adaptive_truth(
     let t = Instant::now();
     let prediction = evaluator.predict_truth_of(scene.shape, &scene.camera, opts.size, scene.light);
     let predict_ms = t.elapsed().as_secs_f64() * 1e3;
+    let guide = prediction.luminance();
     let mut out = Vec::new();
     let mut tgt = ViewTarget::new(r, opts.size.0, opts.size.1)?;
     for &budget in &opts.adaptive {
@@ -489,7 +490,10 @@ fn adaptive_truth(
                         own,
                     )
                 }
-                Strategy::Reconstructed { progressive: prog } => {
+                Strategy::Reconstructed {
+                    progressive: prog,
+                    guided,
+                } => {
                     let rays = if prog {
                         progressive(false, &mut tgt)?
                     } else {
@@ -502,6 +506,7 @@ fn adaptive_truth(
                         &tgt.read(r)?,
                         &tgt.read_moments(r)?,
                         &prediction.sd,
+                        guided.then_some(guide.as_slice()),
                         WindowOptions::default(),
                     );
                     let plan = SamplingPlan {

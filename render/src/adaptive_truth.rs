@@ -292,11 +292,14 @@ pub fn ray_costs(work: &[u32], rays: &[u32]) -> Vec<f64> {
 /// of the largest window around it whose mean stays within its noise. One ray's variance per pixel
 /// is its measured sample variance pooled with the prediction `predicted` ([`pixel_deviations`];
 /// a `predicted` of the wrong size counts as 0, which shrinks the measured variance and so the
-/// windows). Returns the image (weight 1) and the windows.
+/// windows). `guide`, the predicted luminance per pixel, refuses windows it predicts biased
+/// ([`lodestone_core::eval::adaptive_window::reconstruct`]). Returns the image (weight 1) and the
+/// windows.
 pub fn reconstruct_truth(
     image: &LinearImage,
     moments: &SampleMoments,
     predicted: &[f64],
+    guide: Option<&[f64]>,
     options: WindowOptions,
 ) -> (LinearImage, WindowReconstruction) {
     let n = (image.width as usize) * (image.height as usize);
@@ -317,6 +320,7 @@ pub fn reconstruct_truth(
         image.width as usize,
         image.height as usize,
         &samples,
+        guide,
         options,
     );
     let out = LinearImage {

@@ -34,6 +34,7 @@ fn reconstruction(frame: &Frame) -> Option<(LinearImage, WindowReconstruction)> 
         &frame.image,
         frame.moments.as_deref()?,
         &predicted,
+        None,
         WindowOptions::default(),
     ))
 }

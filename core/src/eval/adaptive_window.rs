@@ -115,13 +115,26 @@ impl Table {
     }
 }
 
+/// How far a guide's predicted bias may go, in standard errors of the window's mean: a window is
+/// kept only while `|Σ n_i F_i / Σ n_i − F_p| ≤ GUIDE_BIAS·s_k`, so the bias it adds costs at most
+/// `GUIDE_BIAS²` of its variance.
+pub const GUIDE_BIAS: f64 = 0.5;
+
 /// Reconstruct a `width × height` ground truth from its per-pixel `samples` (row-major) by ICI
 /// over square windows (module docs). A `samples` of the wrong length is read as far as it goes,
 /// the rest as pixels without rays; every output is finite.
+///
+/// With a `guide` (the truth's predicted luminance per pixel, e.g. the filtered view), a window is
+/// also refused where the guide predicts it biased ([`GUIDE_BIAS`]): the prediction says where an
+/// image is textured at the pixel scale, which ICI's intervals cannot see through the noise of a
+/// few rays, and the rays' intervals veto what the prediction gets wrong. The guide only chooses
+/// windows; the values are the rays'. A guide of the wrong length, or non-finite entries, count as
+/// no prediction there.
 pub fn reconstruct(
     width: usize,
     height: usize,
     samples: &[WindowSample],
+    guide: Option<&[f64]>,
     options: WindowOptions,
 ) -> WindowReconstruction {
     let n = width * height;
@@ -151,6 +164,8 @@ pub fn reconstruct(
         s.rays * (0..3).map(|k| LUMINANCE[k] * s.mean[k]).sum::<f64>()
     });
     let var = Table::new(width, height, |p| sample(p).rays * sample(p).ray_var);
+    let guide = guide.filter(|g| g.len() == n && g.iter().all(|v| v.is_finite()));
+    let guided = guide.map(|g| Table::new(width, height, |p| sample(p).rays * g[p]));
     let gamma = if options.gamma.is_finite() {
         options.gamma.max(0.0)
     } else {
@@ -181,6 +196,12 @@ pub fn reconstruct(
                 lo = lo.max(m - gamma * s);
                 hi = hi.min(m + gamma * s);
                 if lo > hi {
+                    break;
+                }
+                if let (Some(g), Some(t)) = (guide, &guided)
+                    && r > 0
+                    && (t.sum(x0, x1, y0, y1) / total - g[p]).abs() > GUIDE_BIAS * s
+                {
                     break;
                 }
                 chosen = Some((r, x0, x1, y0, y1, total));
@@ -251,7 +272,7 @@ mod tests {
         let (w, h) = (48, 40);
         let s = noisy(w, h, 4.0, 0.3, |_, _| 0.5, 7);
         let raw: Vec<[f64; 3]> = s.iter().map(|s| s.mean).collect();
-        let r = reconstruct(w, h, &s, WindowOptions::default());
+        let r = reconstruct(w, h, &s, None, WindowOptions::default());
         let (e_raw, e) = (rmse(&raw, w, |_, _| 0.5), rmse(&r.rgb, w, |_, _| 0.5));
         assert!((e_raw - 0.15).abs() < 0.01, "{e_raw}");
         assert!(e < e_raw / 6.0, "{e} against {e_raw}");
@@ -271,7 +292,7 @@ mod tests {
         let f = |x: usize, _y: usize| if x < 24 { 0.2 } else { 1.2 };
         let s = noisy(w, h, 16.0, 0.3, f, 11);
         let raw: Vec<[f64; 3]> = s.iter().map(|s| s.mean).collect();
-        let r = reconstruct(w, h, &s, WindowOptions::default());
+        let r = reconstruct(w, h, &s, None, WindowOptions::default());
         let e_raw = rmse(&raw, w, f);
         let e = rmse(&r.rgb, w, f);
         assert!(e < e_raw / 2.0, "{e} against {e_raw}");
@@ -290,6 +311,7 @@ mod tests {
             w,
             h,
             &s,
+            None,
             WindowOptions {
                 max_radius: 8,
                 gamma: 1e9,
@@ -307,7 +329,7 @@ mod tests {
         let f = |x: usize, y: usize| 0.2 + 0.01 * x as f64 + 0.005 * y as f64;
         let s = noisy(w, h, 4.0, 0.3, f, 3);
         let raw: Vec<[f64; 3]> = s.iter().map(|s| s.mean).collect();
-        let r = reconstruct(w, h, &s, WindowOptions::default());
+        let r = reconstruct(w, h, &s, None, WindowOptions::default());
         assert!(rmse(&r.rgb, w, f) < rmse(&raw, w, f) / 3.0);
     }
 
@@ -319,6 +341,7 @@ mod tests {
             w,
             h,
             &s,
+            None,
             WindowOptions {
                 max_radius: 0,
                 gamma: 2.0,
@@ -331,11 +354,45 @@ mod tests {
         }
         // A pixel without rays takes the first window that has some, with own weight 0.
         s[2 * w + 3].rays = 0.0;
-        let r = reconstruct(w, h, &s, WindowOptions::default());
+        let r = reconstruct(w, h, &s, None, WindowOptions::default());
         let p = 2 * w + 3;
         assert_eq!(r.own_weight[p], 0.0);
         assert!(r.radius[p] >= 1);
         assert!((r.rgb[p][0] - 3.0).abs() < 0.5, "{:?}", r.rgb[p]);
+    }
+
+    #[test]
+    fn a_guide_keeps_texture_that_the_noise_hides() {
+        // A checkerboard of ±0.05 under 4 rays of deviation 0.3 (0.15 a pixel): ICI cannot see
+        // the pattern through the noise and pools it away, leaving its whole amplitude as error
+        // (0.05); a guide that knows the pattern keeps each pixel's own rays where pooling would
+        // bias it, and pools the flat half of the image.
+        let (w, h) = (48, 40);
+        let f = |x: usize, y: usize| {
+            if x < 24 {
+                0.5 + if (x + y) % 2 == 0 { 0.05 } else { -0.05 }
+            } else {
+                0.5
+            }
+        };
+        let s = noisy(w, h, 64.0, 0.3, f, 13);
+        let guide: Vec<f64> = (0..w * h).map(|p| f(p % w, p / w)).collect();
+        let blind = reconstruct(w, h, &s, None, WindowOptions::default());
+        let guided = reconstruct(w, h, &s, Some(&guide), WindowOptions::default());
+        let textured = |r: &WindowReconstruction| {
+            let e: f64 = (0..h)
+                .flat_map(|y| (2..22).map(move |x| (x, y)))
+                .map(|(x, y)| (r.rgb[y * w + x][0] - f(x, y)).powi(2))
+                .sum();
+            (e / (20 * h) as f64).sqrt()
+        };
+        // Raw noise 0.3/8 = 0.0375 a pixel.
+        assert!(textured(&blind) > 0.045, "{}", textured(&blind));
+        assert!(textured(&guided) < 0.042, "{}", textured(&guided));
+        // The flat half is pooled either way.
+        let flat = 20 * w + 36;
+        assert!(guided.radius[flat] >= 4, "{}", guided.radius[flat]);
+        assert_eq!(guided.radius[20 * w + 10], 0);
     }
 
     #[test]
@@ -374,14 +431,14 @@ mod tests {
                 gamma: f64::NAN,
             },
         ] {
-            let r = reconstruct(3, 2, &bad, options);
+            let r = reconstruct(3, 2, &bad, Some(&[f64::NAN; 6]), options);
             assert_eq!(r.rgb.len(), 6);
             assert!(r.rgb.iter().flatten().all(|c| c.is_finite()), "{r:?}");
             assert!(r.own_weight.iter().all(|w| (0.0..=1.0).contains(w)));
         }
-        assert!(reconstruct(0, 0, &[], WindowOptions::default()).rgb.is_empty());
+        assert!(reconstruct(0, 0, &[], None, WindowOptions::default()).rgb.is_empty());
         // No rays anywhere: black, nothing of its own.
-        let r = reconstruct(2, 2, &[], WindowOptions::default());
+        let r = reconstruct(2, 2, &[], None, WindowOptions::default());
         assert_eq!(r.rgb, vec![[0.0; 3]; 4]);
     }
 }
