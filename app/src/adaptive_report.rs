@@ -12,6 +12,7 @@
 //! capped at R/2 so that every shaded pixel is a prefix.
 
 use crate::chart::{Chart, Series};
+use lodestone_core::math::correlation::{pearson, spearman};
 use lodestone_render::LinearImage;
 use lodestone_render::truth_noise::TruthEstimate;
 use serde::Serialize;
@@ -187,6 +188,54 @@ pub fn uniform_rays_at(uniform: &[UniformPoint], error: f64) -> f64 {
     let (first, last) = (pts[0], pts[pts.len() - 1]);
     let (n0, e0) = if e > first.1 { first } else { last };
     (n0 - 2.0 * (e - e0)).exp()
+}
+
+/// How well the model's predicted deviation of one ray (`TruthPrediction::sd`) matches what the
+/// reference's rays measured, over the pixels where both are known and positive.
+#[derive(Clone, Copy, Debug, Serialize, PartialEq)]
+pub struct PredictionCheck {
+    /// Pixels compared (the reference has at least two rays there and both deviations are
+    /// positive).
+    pub pixels: usize,
+    /// Spearman's rank correlation of predicted and measured deviations (what the ray counts
+    /// need: which pixels are noisier).
+    pub rank_correlation: f64,
+    /// Pearson's correlation of their logarithms.
+    pub log_correlation: f64,
+    /// Median of predicted over measured (1: unbiased in scale).
+    pub median_ratio: f64,
+}
+
+/// [`PredictionCheck`] of `predicted` (per pixel, row-major) against the reference's per-pixel
+/// sample deviation of one ray's luminance, `√(n · Var(mean))` from its squared sums. `None` with
+/// fewer than three pixels to compare or sizes that do not match.
+pub fn prediction_check(predicted: &[f64], reference: &TruthEstimate) -> Option<PredictionCheck> {
+    let img = reference.image();
+    let w = img.width;
+    if predicted.len() != img.pixels.len() {
+        return None;
+    }
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    for (i, (sd, px)) in predicted.iter().zip(&img.pixels).enumerate() {
+        let n = f64::from(px[3]);
+        let measured = (reference.pixel(i as u32 % w, i as u32 / w).var_mean_y * n).sqrt();
+        if n >= 2.0 && *sd > 0.0 && sd.is_finite() && measured > 0.0 && measured.is_finite() {
+            a.push(*sd);
+            b.push(measured);
+        }
+    }
+    if a.len() < 3 {
+        return None;
+    }
+    let mut ratios: Vec<f64> = a.iter().zip(&b).map(|(p, m)| p / m).collect();
+    ratios.sort_by(f64::total_cmp);
+    let log = |v: &[f64]| v.iter().map(|x| x.ln()).collect::<Vec<_>>();
+    Some(PredictionCheck {
+        pixels: a.len(),
+        rank_correlation: spearman(&a, &b),
+        log_correlation: pearson(&log(&a), &log(&b)),
+        median_ratio: ratios[ratios.len() / 2],
+    })
 }
 
 /// Every budget any configuration ran, ascending.
@@ -373,5 +422,43 @@ mod tests {
         assert!((a.ray_gain() - 8.0).abs() < 1e-9);
         // Uniform: 2 ms a ray, 32 rays = 64 ms, against 8 ms.
         assert!((a.time_gain(&u) - 8.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn the_prediction_check_ranks_and_scales() {
+        use lodestone_render::truth_noise::SampleMoments;
+        // Four grey pixels of 4 rays with per-ray deviations 0.1, 0.2, 0.3, 0.4 (sums 4·0.5,
+        // squared sums 3s² + 4·0.25); predicted twice those in the same order, and one pixel
+        // with one ray (left out).
+        let sds = [0.1, 0.2, 0.3, 0.4];
+        let mut pixels: Vec<[f32; 4]> = vec![[2.0, 2.0, 2.0, 4.0]; 4];
+        let mut sum_sq: Vec<[f32; 4]> = sds
+            .iter()
+            .map(|s| [(3.0 * s * s + 1.0) as f32; 4])
+            .collect();
+        pixels.push([0.5, 0.5, 0.5, 1.0]);
+        sum_sq.push([0.25; 4]);
+        let img = LinearImage {
+            width: 5,
+            height: 1,
+            pixels,
+        };
+        let moments = SampleMoments {
+            width: 5,
+            height: 1,
+            sum_sq,
+        };
+        let est = TruthEstimate::new(&img, &moments).unwrap();
+        let predicted = [0.2, 0.4, 0.6, 0.8, 1.0];
+        let c = prediction_check(&predicted, &est).unwrap();
+        assert_eq!(c.pixels, 4);
+        assert!((c.rank_correlation - 1.0).abs() < 1e-12, "{c:?}");
+        assert!((c.log_correlation - 1.0).abs() < 1e-6, "{c:?}");
+        assert!((c.median_ratio - 2.0).abs() < 1e-3, "{c:?}");
+        // Reversed order: rank correlation −1.
+        let reversed = [0.8, 0.6, 0.4, 0.2, 1.0];
+        let c = prediction_check(&reversed, &est).unwrap();
+        assert!((c.rank_correlation + 1.0).abs() < 1e-12, "{c:?}");
+        assert!(prediction_check(&predicted[..3], &est).is_none());
     }
 }

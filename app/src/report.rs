@@ -18,7 +18,8 @@
 //!   timestamp queries are not used. On the software adapter they are CPU times.
 
 use crate::adaptive_report::{
-    ADAPTIVE_RPP, AdaptiveResult, STRATEGIES, Strategy, UniformPoint, rmse_true, uniform_rays_at,
+    ADAPTIVE_RPP, AdaptiveResult, PredictionCheck, STRATEGIES, Strategy, UniformPoint,
+    prediction_check, rmse_true, uniform_rays_at,
 };
 use crate::chart::{Chart, Series};
 use crate::cielab::delta_e76;
@@ -127,6 +128,9 @@ pub struct ConfigResult {
     pub uniform: Vec<UniformPoint>,
     /// Adaptive ground truth per strategy and budget.
     pub adaptive: Vec<AdaptiveResult>,
+    /// The model's predicted deviation of one ray against the reference's measured one (with
+    /// adaptive ground truth; `None` without, or with too few pixels).
+    pub prediction: Option<PredictionCheck>,
 }
 
 /// The report.
@@ -385,8 +389,8 @@ pub fn run_with(
                         ms: ray_ms * f64::from(*n),
                     })
                     .collect();
-                let adaptive = if opts.adaptive.is_empty() {
-                    Vec::new()
+                let (adaptive, prediction) = if opts.adaptive.is_empty() {
+                    (Vec::new(), None)
                 } else {
                     adaptive_truth(
                         &r,
@@ -407,6 +411,7 @@ pub fn run_with(
                     methods,
                     uniform,
                     adaptive,
+                    prediction,
                 };
                 progress(done, total, &c);
                 configs.push(c);
@@ -439,11 +444,12 @@ fn adaptive_truth(
     opts: &Options,
     reference: &TruthEstimate,
     uniform: &[UniformPoint],
-) -> Result<Vec<AdaptiveResult>> {
+) -> Result<(Vec<AdaptiveResult>, Option<PredictionCheck>)> {
     let t = Instant::now();
     let prediction = evaluator.predict_truth_of(scene.shape, &scene.camera, opts.size, scene.light);
     let predict_ms = t.elapsed().as_secs_f64() * 1e3;
     let guide = prediction.luminance();
+    let check = prediction_check(&prediction.sd, reference);
     let mut out = Vec::new();
     let mut tgt = ViewTarget::new(r, opts.size.0, opts.size.1)?;
     for &budget in &opts.adaptive {
@@ -470,7 +476,12 @@ fn adaptive_truth(
                         max_rays,
                     };
                     let a = render_adaptive(r, &mut tgt, gm, scene, &prediction, a_opts)?;
-                    let own = a.plan.rays.iter().map(|n| f64::from(u8::from(*n > 0))).collect();
+                    let own = a
+                        .plan
+                        .rays
+                        .iter()
+                        .map(|n| f64::from(u8::from(*n > 0)))
+                        .collect();
                     (a, own)
                 }
                 Strategy::Progressive { cost_aware } => {
@@ -497,7 +508,10 @@ fn adaptive_truth(
                     let rays = if prog {
                         progressive(false, &mut tgt)?
                     } else {
-                        let rays = vec![(budget.round() as u32).clamp(1, max_rays.max(1)); size_w * size_h];
+                        let rays = vec![
+                            (budget.round() as u32).clamp(1, max_rays.max(1));
+                            size_w * size_h
+                        ];
                         tgt.reset();
                         r.draw_planned(&mut tgt, gm, scene, &rays);
                         rays
@@ -533,7 +547,7 @@ fn adaptive_truth(
             });
         }
     }
-    Ok(out)
+    Ok((out, check))
 }
 
 /// The Markdown tables: per zoom, RMSE and mean ΔE of every method per configuration, then the
@@ -599,6 +613,31 @@ pub fn markdown(rep: &Report) -> String {
         let _ = writeln!(s);
     }
     s.push_str(&crate::adaptive_report::markdown(&adaptive_rows(rep)));
+    if rep.configs.iter().any(|c| c.prediction.is_some()) {
+        let _ = writeln!(
+            s,
+            "Predicted deviation of one ray (the model's σ̂, what the ray counts follow) against the \
+             reference's measured per-pixel deviation:\n\n\
+             | configuration | pixels | rank correlation | log correlation | median predicted/measured |\n\
+             |---|---|---|---|---|"
+        );
+        for c in &rep.configs {
+            if let Some(p) = &c.prediction {
+                let _ = writeln!(
+                    s,
+                    "| {}° d {} light {} | {} | {:.2} | {:.2} | {:.2} |",
+                    c.view_deg,
+                    c.distance,
+                    c.light,
+                    p.pixels,
+                    p.rank_correlation,
+                    p.log_correlation,
+                    p.median_ratio
+                );
+            }
+        }
+        let _ = writeln!(s);
+    }
     s
 }
 

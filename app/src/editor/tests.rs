@@ -469,6 +469,15 @@ fn regenerate_app_screenshots() {
         app.view.adaptive_truth = true;
         app.view.truth_display = TruthDisplay::Rays;
     });
+    shoot("truth-reconstructed", &|h| {
+        // A grazing ground truth of 8 rays a pixel, reconstructed over the windows that are flat
+        // within its noise (View → Ground truth shows → image, reconstructed).
+        let app = h.state_mut();
+        app.view.camera.elevation_deg = 80.0;
+        app.view.camera.distance = 6.0;
+        app.view.truth_spp = 8;
+        app.view.truth_display = TruthDisplay::Reconstructed;
+    });
     shoot("snow-under-sky-grazing", &|h| {
         let ctx = h.ctx.clone();
         h.state_mut().open_path(&ctx, &preset("snow-under-sky.ron"));

@@ -430,7 +430,11 @@ impl EditorApp {
                 }
                 _ => "",
             };
-            note(ui, img, &format!("no {} for this truth yet{why}", d.label()));
+            note(
+                ui,
+                img,
+                &format!("no {} for this truth yet{why}", d.label()),
+            );
         }
         if show_error {
             self.legend(ui, img);

@@ -158,7 +158,8 @@ pub fn reconstruct(
         }
     };
     let weights = Table::new(width, height, |p| sample(p).rays);
-    let channels = [0, 1, 2].map(|k| Table::new(width, height, |p| sample(p).rays * sample(p).mean[k]));
+    let channels =
+        [0, 1, 2].map(|k| Table::new(width, height, |p| sample(p).rays * sample(p).mean[k]));
     let lum = Table::new(width, height, |p| {
         let s = sample(p);
         s.rays * (0..3).map(|k| LUMINANCE[k] * s.mean[k]).sum::<f64>()
@@ -280,7 +281,11 @@ mod tests {
         assert!(widest as f64 > 0.8 * (w * h) as f64, "{widest}");
         // Own weights: 1/(window's pixels) where the window is widest and inside.
         let p = 20 * w + 24;
-        assert!((r.own_weight[p] - 1.0 / 289.0).abs() < 1e-12, "{}", r.own_weight[p]);
+        assert!(
+            (r.own_weight[p] - 1.0 / 289.0).abs() < 1e-12,
+            "{}",
+            r.own_weight[p]
+        );
     }
 
     #[test]
@@ -318,7 +323,11 @@ mod tests {
             },
         );
         let p = 20 * w + 23;
-        assert!((always.rgb[p][0] - f(23, 20)).abs() > 0.4, "{:?}", always.rgb[p]);
+        assert!(
+            (always.rgb[p][0] - f(23, 20)).abs() > 0.4,
+            "{:?}",
+            always.rgb[p]
+        );
     }
 
     #[test]
@@ -370,7 +379,7 @@ mod tests {
         let (w, h) = (48, 40);
         let f = |x: usize, y: usize| {
             if x < 24 {
-                0.5 + if (x + y) % 2 == 0 { 0.05 } else { -0.05 }
+                0.5 + if (x + y).is_multiple_of(2) { 0.05 } else { -0.05 }
             } else {
                 0.5
             }
@@ -436,7 +445,11 @@ mod tests {
             assert!(r.rgb.iter().flatten().all(|c| c.is_finite()), "{r:?}");
             assert!(r.own_weight.iter().all(|w| (0.0..=1.0).contains(w)));
         }
-        assert!(reconstruct(0, 0, &[], None, WindowOptions::default()).rgb.is_empty());
+        assert!(
+            reconstruct(0, 0, &[], None, WindowOptions::default())
+                .rgb
+                .is_empty()
+        );
         // No rays anywhere: black, nothing of its own.
         let r = reconstruct(2, 2, &[], None, WindowOptions::default());
         assert_eq!(r.rgb, vec![[0.0; 3]; 4]);

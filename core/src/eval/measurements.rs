@@ -273,3 +273,161 @@ fn specular_presets_against_ground_truth() {
         }
     }
 }
+
+/// Is the grazing diffuse error slope-conditioned masking (#17: snake-skin at 75°, snow-under-sky
+/// at 85°, default at 75–85° with specular 0)? Over points of the explicit surface (uniform on the
+/// mean plane, each weighted by its projected area toward the eye `u = ωo_z − ∇h·ωo_xy`, front
+/// faces only), with each point's radiance lit and unlit from `shade_hit`:
+/// - `truth`: the points the eye sees, lit where a shadow ray reaches the sun;
+/// - `height only`: each point weighted by the empirical probability that a point *of its height*
+///   is seen, and lit with the empirical probability that a seen point of its height is lit: the
+///   best any model gets whose visibility depends on height but not on slope (Smith's, height
+///   correlated, exactly fitted to this surface);
+/// - `none`: visibility independent of the point (one G1, one V̄).
+///
+/// `truth − height only` is what slope-conditioned masking and shadowing would add. The filtered
+/// model's far patch and the truth's own rays (`ground_truth`) are printed beside it. Measurement
+/// (`cargo test --release -p lodestone-core -- --ignored --nocapture slope_conditioned_visibility`).
+#[test]
+#[ignore = "a measurement, prints a table"]
+fn slope_conditioned_visibility() {
+    use crate::math::random::splitmix;
+    use crate::microfacet::slopes::normal_of;
+    use glam::DMat3;
+    const BINS: usize = 24;
+    let n_points = 300_000;
+    for (name, view, light, az, no_specular) in [
+        ("default", 75.0, 75.0, 0.0, true),
+        ("default", 85.0, 85.0, 0.0, true),
+        ("snake-skin", 75.0, 30.0, 0.0, false),
+        ("snake-skin", 75.0, 30.0, 180.0, false),
+        ("snow-under-sky", 85.0, 30.0, 0.0, false),
+        ("snow-under-sky", 85.0, 0.0, 0.0, false),
+    ] {
+        let mut m = preset(name);
+        if no_specular {
+            m.brdf.specular = 0.0;
+        }
+        let p = Evaluator::new(&m).expect("prepared");
+        let s = &p.surface;
+        let wo = direction(f64::to_radians(view), 0.0);
+        let wi = if light == 0.0 {
+            DVec3::Z
+        } else {
+            direction(f64::to_radians(light), f64::to_radians(az))
+        };
+        let h_max = s.h_max.max(1e-12);
+        let bin = |h: f64| (((h / h_max + 1.0) * 0.5 * BINS as f64) as usize).min(BINS - 1);
+        // Per point: (u, height bin, seen, lit given seen, L lit, L unlit); and the slope
+        // along the view azimuth t = ∇h·ωo_xy/|ωo_xy| (negative: facing the eye) per point.
+        let mut pts = Vec::with_capacity(n_points);
+        let mut slopes = Vec::with_capacity(n_points);
+        let mut rng = 7u64;
+        for _ in 0..n_points {
+            let x = DVec2::new(
+                200.0 * splitmix(&mut rng) - 100.0,
+                200.0 * splitmix(&mut rng) - 100.0,
+            );
+            let (f, h, grad) = s.sample(x);
+            let u = wo.z - grad.x * wo.x - grad.y * wo.y;
+            if u <= 0.0 {
+                continue;
+            }
+            let n = normal_of(grad);
+            let pt = DVec3::new(x.x, x.y, h);
+            let seen = s.sees(pt, wo);
+            let lit = seen && n.dot(wi) > 0.0 && s.sees(pt, wi);
+            let l1 = p.shade_hit(f, n, wo, wi, &DMat3::IDENTITY, || true);
+            let l0 = p.shade_hit(f, n, wo, wi, &DMat3::IDENTITY, || false);
+            pts.push((u, bin(h), seen, lit, l1, l0));
+            slopes.push((grad.x * wo.x + grad.y * wo.y) / wo.x.hypot(wo.y).max(1e-12));
+        }
+        // Empirical P(seen | h) and P(lit | seen, h), projected-area weighted.
+        let (mut all, mut seen_w, mut lit_w) = ([0.0; BINS], [0.0; BINS], [0.0; BINS]);
+        for (u, b, seen, lit, ..) in &pts {
+            all[*b] += u;
+            if *seen {
+                seen_w[*b] += u;
+                if *lit {
+                    lit_w[*b] += u;
+                }
+            }
+        }
+        let g1 = |b: usize| {
+            if all[b] > 0.0 {
+                seen_w[b] / all[b]
+            } else {
+                0.0
+            }
+        };
+        let vb = |b: usize| {
+            if seen_w[b] > 0.0 {
+                lit_w[b] / seen_w[b]
+            } else {
+                0.0
+            }
+        };
+        let g1_all = seen_w.iter().sum::<f64>() / all.iter().sum::<f64>();
+        let v_all = lit_w.iter().sum::<f64>() / seen_w.iter().sum::<f64>();
+        let (mut t, mut tw, mut hh, mut hw, mut nn, mut nw) =
+            ([0.0; 3], 0.0, [0.0; 3], 0.0, [0.0; 3], 0.0);
+        for (u, b, seen, lit, l1, l0) in &pts {
+            let (g, v) = (g1(*b), vb(*b));
+            for k in 0..3 {
+                if *seen {
+                    t[k] += u * if *lit { l1[k] } else { l0[k] };
+                }
+                hh[k] += u * g * (v * l1[k] + (1.0 - v) * l0[k]);
+                nn[k] += u * g1_all * (v_all * l1[k] + (1.0 - v_all) * l0[k]);
+            }
+            if *seen {
+                tw += u;
+            }
+            hw += u * g;
+            nw += u * g1_all;
+        }
+        let t = t.map(|v| v / tw);
+        let hh = hh.map(|v| v / hw);
+        let nn = nn.map(|v| v / nw);
+        let cfg = FootprintQuery::far(&p, wo, wi);
+        let gt = p.ground_truth(&cfg, 100_000, 5);
+        let rel = |v: [f64; 3], r: [f64; 3]| {
+            (0..3)
+                .map(|k| 100.0 * (v[k] - r[k]) / r[k])
+                .fold(0.0f64, |a, e| if e.abs() > a.abs() { e } else { a })
+        };
+        eprintln!(
+            "{name:15} view {view} light {light}/{az}: height-only model {:+6.2}%, no conditioning {:+6.2}% \
+             (against the point truth); filtered {:+6.2}%, point truth {:+6.2}% (against the ray truth, s.e. {:.2}%); \
+             G1 {g1_all:.3}, V̄ {v_all:.3}",
+            rel(hh, t),
+            rel(nn, t),
+            rel(p.filtered(&cfg), gt.mean),
+            rel(t, gt.mean),
+            worst_error(gt.mean, &gt).1,
+        );
+        // P(seen | t) over P(seen), in five bins of t at ±0.5, 1.5 standard deviations
+        // (projected-area weighted, front faces): Smith's G1 is 1 in every bin.
+        let n = slopes.len() as f64;
+        let sd = (slopes.iter().map(|t| t * t).sum::<f64>() / n)
+            .sqrt()
+            .max(1e-12);
+        let (mut w, mut ws) = ([0.0; 5], [0.0; 5]);
+        for ((u, _, seen, ..), t) in pts.iter().zip(&slopes) {
+            let z = t / sd;
+            let b = [-1.5, -0.5, 0.5, 1.5].iter().filter(|e| z > **e).count();
+            w[b] += u;
+            if *seen {
+                ws[b] += u;
+            }
+        }
+        let ratio: Vec<String> = (0..5)
+            .map(|b| format!("{:.2}", ws[b] / w[b].max(1e-300) / g1_all))
+            .collect();
+        eprintln!(
+            "    P(seen | t)/G1 for t/σ_t in (−∞,−1.5), (−1.5,−0.5), (−0.5,0.5), (0.5,1.5), (1.5,∞) \
+             (negative t faces the eye; σ_t {sd:.3}): {}",
+            ratio.join(" ")
+        );
+    }
+}

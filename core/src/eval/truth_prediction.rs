@@ -110,6 +110,7 @@ mod tests {
     use super::*;
     use crate::eval::Method;
     use crate::eval::test_materials::preset;
+    use crate::math::correlation::{pearson, spearman};
     use crate::scene::direction::direction;
 
     /// The mean is the filtered view pixel for pixel; the sky predicts 0; the deviation follows
@@ -171,27 +172,8 @@ mod tests {
                 ys.push(lum(e.std_error) * 600f64.sqrt());
             }
         }
-        let r = correlation(&xs, &ys);
+        let r = pearson(&xs, &ys);
         assert!(r > 0.6, "correlation {r}");
-    }
-
-    fn ranks(v: &[f64]) -> Vec<f64> {
-        let mut order: Vec<usize> = (0..v.len()).collect();
-        order.sort_by(|a, b| v[*a].total_cmp(&v[*b]));
-        let mut r = vec![0.0; v.len()];
-        for (k, i) in order.into_iter().enumerate() {
-            r[i] = k as f64;
-        }
-        r
-    }
-
-    fn correlation(a: &[f64], b: &[f64]) -> f64 {
-        let n = a.len() as f64;
-        let (ma, mb) = (a.iter().sum::<f64>() / n, b.iter().sum::<f64>() / n);
-        let cov: f64 = a.iter().zip(b).map(|(x, y)| (x - ma) * (y - mb)).sum();
-        let va: f64 = a.iter().map(|x| (x - ma).powi(2)).sum();
-        let vb: f64 = b.iter().map(|y| (y - mb).powi(2)).sum();
-        cov / (va * vb).sqrt()
     }
 
     /// On a cylinder the mean is the filtered cylinder view pixel for pixel (the environment
@@ -241,7 +223,7 @@ mod tests {
         );
         // Rank correlation: one glint pixel (measured 0.22 against 0.05 predicted) would rule
         // a linear one.
-        let r = correlation(&ranks(&xs), &ranks(&ys));
+        let r = spearman(&xs, &ys);
         assert!(r > 0.5, "rank correlation {r} over {} pixels", xs.len());
     }
 

@@ -3,6 +3,7 @@
 //! reproducible random numbers of the Monte Carlo paths.
 
 pub mod bessel;
+pub mod correlation;
 pub mod gaussian;
 pub mod piecewise;
 pub mod quadrature;
