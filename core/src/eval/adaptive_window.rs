@@ -20,7 +20,10 @@
 //! Goldenshluger & Nemirovski). The chosen window's RGB mean is the pixel's value.
 //!
 //! Windows are clipped at the image's border. A pixel with no rays of its own starts at the first
-//! window that has some (its value is interpolated from its neighbours).
+//! window that has some (its value is interpolated from its neighbours). Noise differs between
+//! pixels, so a larger window need not have a smaller `s_k` (a sky pixel, exactly 0 with no
+//! variance, beside a glinting horizon): among the windows that pass, the pixel takes the one of
+//! least standard error (the largest on ties), which on evenly noisy images is the largest.
 //!
 //! The decision uses luminance, the quantity the rays' variance is known for; the three channels
 //! follow the same window.
@@ -184,6 +187,7 @@ pub fn reconstruct(
             let p = y * width + x;
             let (mut lo, mut hi) = (f64::NEG_INFINITY, f64::INFINITY);
             let mut chosen = None;
+            let mut best_s = f64::INFINITY;
             for &r in &radii {
                 let r = r as usize;
                 let (x0, x1) = (x.saturating_sub(r), (x + r + 1).min(width));
@@ -205,7 +209,13 @@ pub fn reconstruct(
                 {
                     break;
                 }
-                chosen = Some((r, x0, x1, y0, y1, total));
+                // Noise is not the same everywhere: a window that takes in noisier pixels can
+                // have a larger standard error than a smaller one (a sky pixel, exactly 0, beside
+                // a glinting horizon). Keep the consistent window of least error.
+                if s <= best_s {
+                    best_s = s;
+                    chosen = Some((r, x0, x1, y0, y1, total));
+                }
             }
             if let Some((r, x0, x1, y0, y1, total)) = chosen {
                 out.rgb[p] = if r == 0 {
@@ -379,7 +389,11 @@ mod tests {
         let (w, h) = (48, 40);
         let f = |x: usize, y: usize| {
             if x < 24 {
-                0.5 + if (x + y).is_multiple_of(2) { 0.05 } else { -0.05 }
+                0.5 + if (x + y).is_multiple_of(2) {
+                    0.05
+                } else {
+                    -0.05
+                }
             } else {
                 0.5
             }
@@ -402,6 +416,30 @@ mod tests {
         let flat = 20 * w + 36;
         assert!(guided.radius[flat] >= 4, "{}", guided.radius[flat]);
         assert_eq!(guided.radius[20 * w + 10], 0);
+    }
+
+    #[test]
+    fn an_exact_pixel_is_not_pooled_with_noisier_ones() {
+        // A row of sky (0, known exactly: no variance) above rows of glinting surface (mean 0.1,
+        // one ray's deviation 1, 8 rays): a window reaching into the surface has a mean within
+        // its wide interval of 0, so plain ICI would pool it and bleed the glints into the sky.
+        let (w, h) = (24, 12);
+        let mut s = noisy(w, h, 8.0, 1.0, |_, _| 0.1, 21);
+        for x in 0..w {
+            s[x] = WindowSample {
+                rays: 8.0,
+                mean: [0.0; 3],
+                ray_var: 0.0,
+            };
+        }
+        let r = reconstruct(w, h, &s, None, WindowOptions::default());
+        for x in 0..w {
+            assert_eq!(r.rgb[x], [0.0; 3], "sky pixel {x}: {:?}", r.rgb[x]);
+            assert_eq!(r.radius[x], 0);
+        }
+        // The surface below still pools.
+        let p = 8 * w + 12;
+        assert!(r.radius[p] >= 2, "{}", r.radius[p]);
     }
 
     #[test]
