@@ -21,6 +21,25 @@ fn worst_error(v: [f64; 3], truth: &crate::eval::Estimate) -> (f64, f64) {
     (rel, se)
 }
 
+/// A point of the explicit surface drawn uniformly on the mean plane's square [−100, 100]²,
+/// kept when it faces the eye: its position, driver value, height, gradient and projected area
+/// toward ωo per unit of mean-plane area, `u = ωo_z − ∇h·ωo_xy > 0`.
+struct FrontPoint {
+    x: DVec2,
+    f: f64,
+    h: f64,
+    grad: DVec2,
+    u: f64,
+}
+
+fn front_point(s: &crate::scene::surface::Surface, wo: DVec3, rng: &mut u64) -> Option<FrontPoint> {
+    use crate::math::random::splitmix;
+    let x = DVec2::new(200.0 * splitmix(rng) - 100.0, 200.0 * splitmix(rng) - 100.0);
+    let (f, h, grad) = s.sample(x);
+    let u = wo.z - grad.x * wo.x - grad.y * wo.y;
+    (u > 0.0).then_some(FrontPoint { x, f, h, grad, u })
+}
+
 /// Why the specular lobe is off in the slope distribution's tails (#17, bumpy-specular): the
 /// density of the noise's slopes (σ_h ∇f of a sum of sinusoids, phases uniform: the footprint's
 /// statistics far away) at the half vectors of the failing configurations, by Monte Carlo over the
@@ -291,7 +310,6 @@ fn specular_presets_against_ground_truth() {
 #[test]
 #[ignore = "a measurement, prints a table"]
 fn slope_conditioned_visibility() {
-    use crate::math::random::splitmix;
     use crate::microfacet::slopes::normal_of;
     use glam::DMat3;
     const BINS: usize = 24;
@@ -324,15 +342,9 @@ fn slope_conditioned_visibility() {
         let mut slopes = Vec::with_capacity(n_points);
         let mut rng = 7u64;
         for _ in 0..n_points {
-            let x = DVec2::new(
-                200.0 * splitmix(&mut rng) - 100.0,
-                200.0 * splitmix(&mut rng) - 100.0,
-            );
-            let (f, h, grad) = s.sample(x);
-            let u = wo.z - grad.x * wo.x - grad.y * wo.y;
-            if u <= 0.0 {
+            let Some(FrontPoint { x, f, h, grad, u }) = front_point(s, wo, &mut rng) else {
                 continue;
-            }
+            };
             let n = normal_of(grad);
             let pt = DVec3::new(x.x, x.y, h);
             let seen = s.sees(pt, wo);
@@ -447,7 +459,6 @@ fn slope_conditioned_visibility() {
 #[test]
 #[ignore = "a measurement, prints a table"]
 fn slope_conditioned_masking_prototype() {
-    use crate::math::random::splitmix;
     use crate::math::special::{norm_cdf, norm_pdf};
     use crate::microfacet::slopes::normal_of;
     use glam::DMat3;
@@ -528,15 +539,9 @@ fn slope_conditioned_masking_prototype() {
         let (mut bw, mut bt, mut bc, mut bu) = ([0.0; 5], [0.0; 5], [0.0; 5], [0.0; 5]);
         let (mut hh, mut tt, mut nn) = (0.0, 0.0, 0.0);
         for _ in 0..n_points {
-            let x = DVec2::new(
-                200.0 * splitmix(&mut rng) - 100.0,
-                200.0 * splitmix(&mut rng) - 100.0,
-            );
-            let (f, h, grad) = s.sample(x);
-            let u = wo.z - grad.x * wo.x - grad.y * wo.y;
-            if u <= 0.0 {
+            let Some(FrontPoint { x, f, h, grad, u }) = front_point(s, wo, &mut rng) else {
                 continue;
-            }
+            };
             let t = grad.dot(d);
             hh += h * h;
             tt += t * t;
