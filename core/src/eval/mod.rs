@@ -52,6 +52,8 @@ mod independent;
 #[cfg(test)]
 mod measurements;
 #[cfg(test)]
+mod slope_masking_measurements;
+#[cfg(test)]
 pub(crate) mod test_materials;
 #[cfg(test)]
 mod tests;
