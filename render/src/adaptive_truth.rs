@@ -289,7 +289,7 @@ pub fn ray_costs(work: &[u32], rays: &[u32]) -> Vec<f64> {
 /// A ground truth (`image`, its squared sums `moments`) reconstructed over windows chosen per pixel
 /// by the intersection of confidence intervals
 /// ([`lodestone_core::eval::adaptive_window`], [BSSBH13 Sec. 3]): each pixel's value pools the rays
-/// of the largest window around it whose mean stays within its noise. One ray's variance per pixel
+/// of the least noisy window around it whose mean stays within its noise. One ray's variance per pixel
 /// is its measured sample variance pooled with the prediction `predicted` ([`pixel_deviations`];
 /// a `predicted` of the wrong size counts as 0, which shrinks the measured variance and so the
 /// windows). `guide`, the predicted luminance per pixel, refuses windows it predicts biased

@@ -165,7 +165,7 @@ impl TruthDisplay {
                 "What one more ground-truth ray costs in each pixel: march steps plus eights of waves summed, averaged over its rays (rays that skim the relief toward the horizon march longest)"
             }
             Self::Reconstructed => {
-                "The ground truth with each pixel pooled over the largest square window around it whose mean stays within the truth's own noise (intersection of confidence intervals, Γ = 2, radius ≤ 8; BSSBH13 Sec. 3): far less noise where the image is flat, edges kept. Chosen from the rays alone, never from the filtered model; error maps still use the unpooled truth"
+                "The ground truth with each pixel pooled over the least noisy square window around it whose mean stays within the truth's own noise (intersection of confidence intervals, Γ = 2, radius ≤ 8; BSSBH13 Sec. 3): far less noise where the image is flat, edges kept. Chosen from the rays alone, never from the filtered model; error maps still use the unpooled truth"
             }
             Self::WindowRadius => {
                 "The radius of each pixel's reconstruction window: the scale, in pixels, over which the truth is flat within its noise (its measured bandwidth is about 1/(2r + 1) cycles per pixel); 0 keeps the pixel's own rays"
