@@ -452,22 +452,22 @@ fn adaptive_truth(
     let check = prediction_check(&prediction.sd, reference);
     let mut out = Vec::new();
     let mut tgt = ViewTarget::new(r, opts.size.0, opts.size.1)?;
+    let (size_w, size_h) = (opts.size.0 as usize, opts.size.1 as usize);
+    // At most half the reference's rays a pixel, so every shaded pixel is a prefix of it.
+    let max_rays = opts.reference_spp.max(2) / 2;
     for &budget in &opts.adaptive {
+        let progressive = |cost_aware: bool, tgt: &mut ViewTarget| {
+            let plan = Progressive {
+                predicted: &prediction.sd,
+                rays_per_pixel: budget,
+                max_rays,
+                cost_aware,
+            };
+            render_progressive(r, tgt, gm, scene, plan, |_, _, _| Ok(true))
+        };
         for (strategy, how) in STRATEGIES {
-            // At most half the reference's rays a pixel, so every shaded pixel is a prefix of it.
-            let max_rays = opts.reference_spp.max(2) / 2;
             // One run, as the uniform truth's milestones: its passes are long enough to time once.
             let t = Instant::now();
-            let (size_w, size_h) = (opts.size.0 as usize, opts.size.1 as usize);
-            let progressive = |cost_aware: bool, tgt: &mut ViewTarget| {
-                let plan = Progressive {
-                    predicted: &prediction.sd,
-                    rays_per_pixel: budget,
-                    max_rays,
-                    cost_aware,
-                };
-                render_progressive(r, tgt, gm, scene, plan, |_, _, _| Ok(true))
-            };
             let (a, own): (AdaptiveTruth, Vec<f64>) = match how {
                 Strategy::TwoPass(step) => {
                     let a_opts = AdaptiveOptions {

@@ -160,16 +160,18 @@ pub fn reconstruct(
             ray_var,
         }
     };
-    let weights = Table::new(width, height, |p| sample(p).rays);
-    let channels =
-        [0, 1, 2].map(|k| Table::new(width, height, |p| sample(p).rays * sample(p).mean[k]));
-    let lum = Table::new(width, height, |p| {
-        let s = sample(p);
-        s.rays * (0..3).map(|k| LUMINANCE[k] * s.mean[k]).sum::<f64>()
-    });
-    let var = Table::new(width, height, |p| sample(p).rays * sample(p).ray_var);
-    let guide = guide.filter(|g| g.len() == n && g.iter().all(|v| v.is_finite()));
-    let guided = guide.map(|g| Table::new(width, height, |p| sample(p).rays * g[p]));
+    let clean: Vec<WindowSample> = (0..n).map(sample).collect();
+    let table = |value: &dyn Fn(&WindowSample, usize) -> f64| {
+        Table::new(width, height, |p| clean[p].rays * value(&clean[p], p))
+    };
+    let weights = table(&|_, _| 1.0);
+    let channels = [0, 1, 2].map(|k| table(&|s, _| s.mean[k]));
+    let lum = table(&|s, _| (0..3).map(|k| LUMINANCE[k] * s.mean[k]).sum::<f64>());
+    let var = table(&|s, _| s.ray_var);
+    // The guide with its ray-weighted table, where it is usable.
+    let guide = guide
+        .filter(|g| g.len() == n && g.iter().all(|v| v.is_finite()))
+        .map(|g| (g, table(&|_, p| g[p])));
     let gamma = if options.gamma.is_finite() {
         options.gamma.max(0.0)
     } else {
@@ -203,7 +205,7 @@ pub fn reconstruct(
                 if lo > hi {
                     break;
                 }
-                if let (Some(g), Some(t)) = (guide, &guided)
+                if let Some((g, t)) = &guide
                     && r > 0
                     && (t.sum(x0, x1, y0, y1) / total - g[p]).abs() > GUIDE_BIAS * s
                 {
@@ -219,12 +221,12 @@ pub fn reconstruct(
             }
             if let Some((r, x0, x1, y0, y1, total)) = chosen {
                 out.rgb[p] = if r == 0 {
-                    sample(p).mean
+                    clean[p].mean
                 } else {
                     [0, 1, 2].map(|k| channels[k].sum(x0, x1, y0, y1) / total)
                 };
                 out.radius[p] = r as u32;
-                out.own_weight[p] = (sample(p).rays / total).clamp(0.0, 1.0);
+                out.own_weight[p] = (clean[p].rays / total).clamp(0.0, 1.0);
             }
         }
     }
