@@ -37,6 +37,10 @@ pub enum Command {
         /// Ground-truth samples (eye rays) for the patch (2 to 10⁸: its standard error needs two).
         #[arg(long, default_value_t = 40_000, value_parser = eval_samples)]
         spp: usize,
+        /// The filtered model's masking of the visible slopes: Smith's (the views'), or conditioned
+        /// on the facet's slope along the ray (#17; core only so far, noise drivers).
+        #[arg(long, value_enum, default_value_t = SlopeMaskingArg::Smith)]
+        slope_masking: SlopeMaskingArg,
         /// Print JSON instead of a table.
         #[arg(long)]
         json: bool,
@@ -270,6 +274,24 @@ pub enum Command {
         #[arg(long)]
         cpu_only: bool,
     },
+}
+
+/// `eval --slope-masking`: [`lodestone_core::microfacet::slope_masking::SlopeMasking`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum SlopeMaskingArg {
+    /// Smith's: visibility depends on the height alone.
+    Smith,
+    /// Conditioned on the facet's slope along the ray.
+    Conditioned,
+}
+
+impl From<SlopeMaskingArg> for lodestone_core::microfacet::slope_masking::SlopeMasking {
+    fn from(a: SlopeMaskingArg) -> Self {
+        match a {
+            SlopeMaskingArg::Smith => Self::Smith,
+            SlopeMaskingArg::Conditioned => Self::Conditioned,
+        }
+    }
 }
 
 /// What `render` draws.

@@ -175,8 +175,11 @@ fn run(cli: Cli) -> Result<()> {
             light_deg,
             light_azimuth_deg,
             spp,
+            slope_masking,
             json,
         }) => {
+            let mut preset = preset.clone();
+            preset.material.filtering.slope_masking = slope_masking.into();
             let r = eval::eval(
                 &preset,
                 [view_deg, view_azimuth_deg, light_deg, light_azimuth_deg],

@@ -3,6 +3,7 @@
 //! [HNPN14 Sec. 6] under the directional light and the environment [HNPN14 Sec. 5.3].
 
 use crate::eval::Evaluator;
+use crate::eval::slope_weights::SlopeWeights;
 use crate::material::color_terms::Affine;
 use crate::material::measured::ChannelWeights;
 use crate::material::merl_fit::fresnel_factor;
@@ -81,9 +82,10 @@ impl Evaluator {
         wo: DVec3,
         wi: DVec3,
         frame: &DMat3,
+        weights: Option<&SlopeWeights>,
     ) -> SlopeShading {
         let points = self.material.filtering.slope_points as usize;
-        let (acc, den) = self.visible_shading_sums(mean, sigma, wo, wi, frame, points);
+        let (acc, den) = self.visible_shading_sums(mean, sigma, wo, wi, frame, points, weights);
         if den > 0.0 {
             acc.scaled(1.0 / den)
         } else {
@@ -93,6 +95,11 @@ impl Evaluator {
 
     /// The sums [`Evaluator::visible_shading`] divides: each input weighted by the node's
     /// visible projected area, and the sum of those weights, on the rule of order `points`.
+    /// With slope-conditioned `weights` ([`SlopeWeights`]) each node's weight is also multiplied by
+    /// its masking factor, and the sun's terms by its shadowing factor too, renormalised so that
+    /// the sun's inputs stay averages over the visible slopes (the mean shadowing V̄ is applied
+    /// apart, and only its share among the slopes moves).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn visible_shading_sums(
         &self,
         mean: DVec2,
@@ -101,17 +108,29 @@ impl Evaluator {
         wi: DVec3,
         frame: &DMat3,
         points: usize,
+        weights: Option<&SlopeWeights>,
     ) -> (SlopeShading, f64) {
         let mut acc = SlopeShading::default();
-        let den = visible_slope_nodes(mean, sigma, wo, points, |n, w| {
+        let (mut den, mut den_sun) = (0.0, 0.0);
+        visible_slope_nodes(mean, sigma, wo, points, |n, w| {
+            let (o, oi) = weights.map_or((1.0, 1.0), |c| c.at(slope_of(n)));
+            let (w, ws) = (w * o, w * oi);
+            den += w;
+            den_sun += ws;
             let p = self.point_shading(n, wi, frame);
-            acc.cos += w * p.cos;
+            acc.cos += ws * p.cos;
             for c in 0..3 {
-                acc.cs_cos[c] += w * p.cs_cos[c];
+                acc.cs_cos[c] += ws * p.cs_cos[c];
                 acc.env[c] += w * p.env[c];
                 acc.cs_env[c] += w * p.cs_env[c];
             }
         });
+        // The sun's sums carry the shadowing factor: rescale them to the masking's total.
+        if weights.is_some() && den_sun > 0.0 {
+            let k = den / den_sun;
+            acc.cos *= k;
+            acc.cs_cos = acc.cs_cos.map(|v| v * k);
+        }
         (acc, den)
     }
 

@@ -35,6 +35,7 @@ fn slope_conditioned_visibility() {
         ("default", 75.0, 75.0, 0.0, true),
         ("default", 85.0, 85.0, 0.0, true),
         ("snake-skin", 75.0, 30.0, 0.0, false),
+        ("snake-skin", 75.0, 30.0, 0.0, true),
         ("snake-skin", 75.0, 30.0, 180.0, false),
         ("snow-under-sky", 85.0, 30.0, 0.0, false),
         ("snow-under-sky", 85.0, 0.0, 0.0, false),
@@ -323,6 +324,72 @@ fn slope_conditioned_masking_prototype() {
             bins(&bt, t_w / tot),
             bins(&bc, c_w / tot),
             bins(&bu, u_w / tot)
+        );
+    }
+}
+
+/// The filtered view with Smith's masking and with slope-conditioned masking and shadowing
+/// ([`crate::microfacet::slope_masking`]) against the ground truth's far patch, per channel (the
+/// worst channel's relative error). `cargo test --release -p lodestone-core -- --ignored
+/// --nocapture slope_conditioned_filtered`.
+#[test]
+#[ignore = "a measurement, prints a table"]
+fn slope_conditioned_filtered() {
+    use crate::microfacet::slope_masking::SlopeMasking;
+    for (name, view, light, az, no_specular) in [
+        ("default", 60.0, 0.0, 0.0, false),
+        ("default", 75.0, 75.0, 0.0, true),
+        ("default", 85.0, 85.0, 0.0, true),
+        ("default", 75.0, 30.0, 0.0, false),
+        ("default", 85.0, 30.0, 180.0, false),
+        ("snake-skin", 75.0, 30.0, 0.0, false),
+        ("snake-skin", 75.0, 30.0, 0.0, true),
+        ("snake-skin", 75.0, 30.0, 180.0, false),
+        ("snow-under-sky", 85.0, 30.0, 0.0, false),
+        ("snow-under-sky", 85.0, 0.0, 0.0, false),
+        ("snow-under-sky", 75.0, 30.0, 0.0, false),
+        ("bumpy-specular", 75.0, 30.0, 0.0, false),
+    ] {
+        let mut m = preset(name);
+        if no_specular {
+            m.brdf.specular = 0.0;
+        }
+        let wo = direction(f64::to_radians(view), 0.0);
+        let wi = if light == 0.0 {
+            DVec3::Z
+        } else {
+            direction(f64::to_radians(light), f64::to_radians(az))
+        };
+        let smith = Evaluator::new(&m).expect("prepared");
+        m.filtering.slope_masking = SlopeMasking::Conditioned;
+        let cond = Evaluator::new(&m).expect("prepared");
+        let cfg = FootprintQuery::far(&smith, wo, wi);
+        let gt = smith.ground_truth(&cfg, 100_000, 5);
+        let t0 = std::time::Instant::now();
+        let c = cond.filtered(&cfg);
+        let ms = t0.elapsed().as_secs_f64() * 1e3;
+        let rel = |v: [f64; 3]| {
+            (0..3)
+                .map(|k| 100.0 * (v[k] - gt.mean[k]) / gt.mean[k])
+                .fold(0.0f64, |a, e| if e.abs() > a.abs() { e } else { a })
+        };
+        let per = |v: [f64; 3]| {
+            (0..3)
+                .map(|k| format!("{:+.1}", 100.0 * (v[k] - gt.mean[k]) / gt.mean[k]))
+                .collect::<Vec<_>>()
+                .join("/")
+        };
+        eprintln!(
+            "    per channel: Smith {}, conditioned {}",
+            per(smith.filtered(&cfg)),
+            per(c)
+        );
+        eprintln!(
+            "{name:15} view {view} light {light}/{az}{}: Smith {:+6.2}%, conditioned {:+6.2}% ({ms:.0} ms); truth s.e. {:.2}%",
+            if no_specular { " (no specular)" } else { "" },
+            rel(smith.filtered(&cfg)),
+            rel(c),
+            worst_error(gt.mean, &gt).1,
         );
     }
 }

@@ -39,6 +39,7 @@ use crate::microfacet::effective_height::HeightFilter;
 use crate::microfacet::height_mixture::TransferSlopes;
 use crate::microfacet::masking_shadowing::Correlation;
 use crate::microfacet::slope_density::NoiseSlopes;
+use crate::microfacet::slope_masking::SlopeMasking;
 use crate::microfacet::slopes::SlopeCov;
 use serde::{Deserialize, Serialize};
 
@@ -141,6 +142,11 @@ pub struct Filtering {
     pub noise_slopes: NoiseSlopes,
     /// An image driver's footprint values: its own histogram (default) or the Gaussian.
     pub image_histogram: ImageHistogram,
+    /// Masking and shadowing of the visible slopes: Smith's, or conditioned on the facet's slope
+    /// along the ray (#17). Core's filtered model only, so not read from presets (an unknown
+    /// field there) until the GPU views mirror it: `lodestone eval --slope-masking conditioned`.
+    #[serde(skip)]
+    pub slope_masking: SlopeMasking,
 }
 
 impl Default for Filtering {
@@ -153,6 +159,7 @@ impl Default for Filtering {
             transfer_slopes: TransferSlopes::default(),
             noise_slopes: NoiseSlopes::default(),
             image_histogram: ImageHistogram::default(),
+            slope_masking: SlopeMasking::default(),
         }
     }
 }

@@ -21,6 +21,7 @@ pub mod effective_height;
 pub mod height_mixture;
 pub mod masking_shadowing;
 pub mod slope_density;
+pub mod slope_masking;
 pub mod slopes;
 pub mod smith;
 pub mod visible_slopes;
