@@ -8,11 +8,13 @@ use crate::driver::field::DriverField;
 use crate::driver::histogram::DriverHistogram;
 use crate::driver::image::ImageDriver;
 use crate::eval::compiled::{CompiledColor, CompiledTransfer};
+use crate::eval::slope_masking_table::SlopeMaskingTable;
 use crate::material::Material;
 use crate::material::environment::EquirectMap;
 use crate::material::measured::{ChannelWeights, MeasuredBrdf};
 use crate::material::slope_color::CompiledSlopeColor;
 use crate::math::sh::Sh9;
+use crate::microfacet::slope_masking::SlopeMasking;
 use crate::scene::surface::Surface;
 use std::sync::Arc;
 
@@ -42,6 +44,9 @@ pub struct Evaluator {
     /// file is read ([`Evaluator::set_measured`]); `None` = the analytic base BRDF (or a file not
     /// loaded yet).
     pub measured: Option<Arc<MeasuredBrdf>>,
+    /// The noise's table of slope-conditioned masking, when the material asks for it
+    /// (`filtering.slope_masking`, [`crate::eval::slope_masking_table`]).
+    pub slope_masking: Option<Arc<SlopeMaskingTable>>,
 }
 
 impl Evaluator {
@@ -115,6 +120,15 @@ impl Evaluator {
                 }),
             _ => None,
         };
+        let slope_masking = match (material.filtering.slope_masking, &surface.driver) {
+            (SlopeMasking::Conditioned, DriverField::Noise(noise)) => previous
+                .filter(|p| {
+                    p.material.driver == material.driver && p.material.slopes == material.slopes
+                })
+                .and_then(|p| p.slope_masking.clone())
+                .or_else(|| SlopeMaskingTable::new(noise).map(Arc::new)),
+            _ => None,
+        };
         let g = material.heights.transfer.moments(0.0, 1.0);
         let environment = match previous {
             Some(p) if p.material.lighting == material.lighting => p.environment,
@@ -130,6 +144,7 @@ impl Evaluator {
             image_slopes,
             environment,
             measured: None,
+            slope_masking,
         })
     }
 

@@ -66,20 +66,14 @@ impl Evaluator {
         let terms = &self.material.terms;
         // The colour model over the visible and lit heights (L = Λo + Λi) for the directional
         // light, over the visible heights (L = Λo) for the unshadowed environment.
-        // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
-        let mean = loc.stats.slope_mean;
-        let weights = self.slope_weights(cfg.footprint, mean, &sigma, cfg.wo, cfg.wi);
-        let filtered_color = |l: f64, lit: bool| {
-            let hm = weights
-                .as_ref()
-                .and_then(|w| w.height_moments(l, lit))
-                .unwrap_or_else(|| height_moments(l, f.height_filter));
+        let filtered_color = |l: f64| {
+            let hm = height_moments(l, f.height_filter);
             self.color
                 .of_distribution(m + s * hm.mean, s * hm.std, l, (hm.mean, hm.std), s * s)
         };
-        let sun_color = terms.affine(filtered_color(ms.total, true));
+        let sun_color = terms.affine(filtered_color(ms.total));
         let env_color = if self.environment.is_some() {
-            terms.affine(filtered_color(ms.lambda_o, false))
+            terms.affine(filtered_color(ms.lambda_o))
         } else {
             sun_color
         };
@@ -88,6 +82,10 @@ impl Evaluator {
         } else {
             0.0
         };
+        // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
+        let mean = loc.stats.slope_mean;
+        let weights = self.slope_weights(cfg.footprint, mean, &sigma, cfg.wo, cfg.wi);
+        // Slope-conditioned masking (#17) reweights the visible slopes and the sun's lobe.
         let shading = self.visible_shading(mean, &sigma, cfg.wo, cfg.wi, frame, weights.as_ref());
         let lit = sun_visible * vbar;
         let mut spec = self.specular_lobes(mean, &sigma, cfg.wo, cfg.wi);

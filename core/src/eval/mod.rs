@@ -44,6 +44,7 @@ pub mod query;
 pub mod ray_variance;
 pub mod sampling_plan;
 pub mod shading;
+pub mod slope_masking_table;
 pub mod slope_weights;
 pub mod truth_prediction;
 pub mod view_independent;

@@ -2,20 +2,14 @@
 //! ([`crate::microfacet::slope_masking`], #17): for a footprint, the unresolved part of the noise
 //! as a height process along the view's and the light's azimuths, and each slope node's factor.
 
-use crate::driver::field::DriverField;
 use crate::driver::footprint::Footprint;
 use crate::eval::Evaluator;
-use crate::math::special::{log_norm_cdf, norm_pdf};
 use crate::microfacet::brdf::lobe_posterior;
-use crate::microfacet::effective_height::HeightMoments;
 use crate::microfacet::masking_shadowing::{Correlation, G2, azimuth_difference, azimuth_factor};
-use crate::microfacet::slope_masking::{
-    HEIGHT_NODES, LineProcess, SLOPE_NODES, SlopeMasking, conditioned_masking, profile_at,
-};
+use crate::microfacet::slope_masking::{SLOPE_NODES, SlopeMasking, profile_at};
 use crate::microfacet::slopes::{SlopeCov, slope_of};
 use crate::microfacet::visible_slopes::visible_slope_nodes;
 use glam::{DVec2, DVec3};
-use std::f64::consts::TAU;
 
 /// One direction's factor: the profile of [`conditioned_masking`] over the slope along `dir`
 /// relative to the footprint's mean, in its standard deviations.
@@ -29,23 +23,12 @@ pub struct DirectionWeights {
     pub sd: f64,
     /// `E_h₀[G1(h₀, z)]` at [`crate::microfacet::slope_masking::slope_node`].
     pub profile: [f64; SLOPE_NODES],
-    /// The conditioned height dependence over Smith's at
-    /// [`crate::microfacet::slope_masking::height_node`] ([`ConditionedMasking::heights`]).
-    pub heights: [f64; HEIGHT_NODES],
 }
 
 impl DirectionWeights {
     /// The factor of a facet of slope `s` (world slope space).
     pub fn at(&self, s: DVec2) -> f64 {
         profile_at(&self.profile, (s.dot(self.dir) - self.mean) / self.sd)
-    }
-
-    /// The height ratio at a height `h` in σ_h (linear between the nodes, the end values beyond).
-    fn height_ratio(&self, h: f64) -> f64 {
-        let x = ((h + 4.5) * 2.0).clamp(0.0, (HEIGHT_NODES - 1) as f64);
-        let i = (x as usize).min(HEIGHT_NODES - 2);
-        let f = x - i as f64;
-        self.heights[i] * (1.0 - f) + self.heights[i + 1] * f
     }
 }
 
@@ -113,46 +96,6 @@ impl SlopeWeights {
             1.0
         }
     }
-
-    /// The effective height distribution's moments (in σ_h) under the conditioned height
-    /// dependence: `D_h ∝ φ(h)Φ(h)^l·ρ(h)` with ρ the view's ratio (`lit` false: masking alone) or
-    /// the view's and the light's combined as in [`SlopeWeights::at`] (`lit`). `l` is the views'
-    /// own exponent (Λo, or L of G2), so without conditioning this is
-    /// [`crate::microfacet::effective_height::height_moments`]. `None` without a view factor.
-    pub fn height_moments(&self, l: f64, lit: bool) -> Option<HeightMoments> {
-        let view = self.view?;
-        const N: usize = 700;
-        let (lo, hi) = (-7.0, 7.0);
-        let dh = (hi - lo) / N as f64;
-        let (mut w0, mut w1, mut w2) = (0.0, 0.0, 0.0);
-        for k in 0..N {
-            let h = lo + (k as f64 + 0.5) * dh;
-            let o = view.height_ratio(h);
-            let rho = match (lit, self.light) {
-                (true, Some(light)) => {
-                    let i = light.height_ratio(h);
-                    if self.view_dominates {
-                        o * i.powf(self.correlation)
-                    } else {
-                        o.powf(self.correlation) * i
-                    }
-                }
-                _ => o,
-            };
-            let w = norm_pdf(h) * (l.max(0.0) * log_norm_cdf(h)).exp() * rho;
-            w0 += w;
-            w1 += w * h;
-            w2 += w * h * h;
-        }
-        if !(w0 > 0.0) {
-            return None;
-        }
-        let mean = w1 / w0;
-        Some(HeightMoments {
-            mean,
-            std: (w2 / w0 - mean * mean).max(0.0).sqrt(),
-        })
-    }
 }
 
 impl Evaluator {
@@ -170,14 +113,8 @@ impl Evaluator {
         if self.material.filtering.slope_masking != SlopeMasking::Conditioned {
             return None;
         }
-        let DriverField::Noise(noise) = &self.surface.driver else {
-            return None;
-        };
-        let attenuations: Vec<f64> = noise
-            .waves
-            .iter()
-            .map(|w| noise.attenuation(w, footprint))
-            .collect();
+        let table = self.slope_masking.as_ref()?;
+        let cov = footprint.cov;
         let direction = |w: DVec3| -> Option<DirectionWeights> {
             let r = w.x.hypot(w.y);
             if !(w.z > 0.0) || !(r > 1e-9) {
@@ -192,21 +129,16 @@ impl Evaluator {
             if !(sd > 1e-12) {
                 return None;
             }
-            let process = LineProcess::new(noise.waves.iter().zip(&attenuations).map(|(w, g)| {
-                (
-                    0.5 * w.amplitude * w.amplitude * (1.0 - g * g).max(0.0),
-                    TAU * w.k.dot(dir),
-                )
-            }))?;
             let m = mean.dot(dir);
             let nu = (w.z / r - m) / sd;
-            let c = conditioned_masking(&process, nu);
+            // The footprint's standard deviation along the ray's azimuth picks the level.
+            let scale = dir.dot(cov * dir).max(0.0).sqrt();
+            let c = table.lookup(dir, scale, nu);
             Some(DirectionWeights {
                 dir,
                 mean: m,
                 sd,
                 profile: c.slopes,
-                heights: c.heights,
             })
         };
         let ms = G2::from_directions(wo, wi, sigma, self.material.filtering.correlation);
@@ -229,7 +161,6 @@ mod tests {
     use super::*;
     use crate::eval::FootprintQuery;
     use crate::eval::test_materials::preset;
-    use crate::microfacet::effective_height::{HeightFilter, height_moments};
     use crate::scene::direction::direction;
 
     fn flat_direction() -> DirectionWeights {
@@ -238,7 +169,6 @@ mod tests {
             mean: 0.0,
             sd: 0.3,
             profile: [1.0; SLOPE_NODES],
-            heights: [1.0; HEIGHT_NODES],
         }
     }
 
@@ -250,19 +180,6 @@ mod tests {
             correlation: 0.6,
             view_dominates: true,
         };
-        // D_h: the quadrature equals the exact table when the ratios are 1.
-        for l in [0.0, 0.3, 2.0, 40.0] {
-            let ours = w.height_moments(l, true).expect("moments");
-            let table = height_moments(l, HeightFilter::Exact);
-            assert!(
-                (ours.mean - table.mean).abs() < 2e-3,
-                "L {l}: {ours:?} {table:?}"
-            );
-            assert!(
-                (ours.std - table.std).abs() < 2e-3,
-                "L {l}: {ours:?} {table:?}"
-            );
-        }
         let sigma = SlopeCov {
             xx: 0.09,
             xy: 0.01,
@@ -313,12 +230,17 @@ mod tests {
         let p =
             Evaluator::with_image(&m, Some(std::sync::Arc::new(image)), None).expect("prepared");
         assert!(p.slope_weights(fp, DVec2::ZERO, &sigma, wo, wi).is_none());
-        // A point footprint resolves every wave: nothing is left to condition.
+        // A point footprint resolves every wave: no unresolved slopes, nothing to condition.
         let mut m = preset("default");
         m.filtering.slope_masking = SlopeMasking::Conditioned;
         let p = Evaluator::new(&m).expect("prepared");
+        let none = SlopeCov {
+            xx: 0.0,
+            xy: 0.0,
+            yy: 0.0,
+        };
         assert!(
-            p.slope_weights(Footprint::point(), DVec2::ZERO, &sigma, wo, wi)
+            p.slope_weights(Footprint::point(), DVec2::ZERO, &none, wo, wi)
                 .is_none()
         );
         assert!(p.slope_weights(fp, DVec2::ZERO, &sigma, wo, wi).is_some());

@@ -35,17 +35,17 @@ pub enum SlopeMasking {
     Conditioned,
 }
 
-/// The slopes (in σ_t) at which [`conditioned_masking`] is tabulated: −4 to 4 by ½.
-pub const SLOPE_NODES: usize = 17;
+/// The slopes (in σ_t) at which [`conditioned_masking`] is tabulated: −4 to 4 by 1.
+pub const SLOPE_NODES: usize = 9;
 
-/// Slope of node `j` of [`SLOPE_NODES`], in standard deviations: `−4 + j/2`.
+/// Slope of node `j` of [`SLOPE_NODES`], in standard deviations: `−4 + j`.
 pub fn slope_node(j: usize) -> f64 {
-    -4.0 + 0.5 * j as f64
+    -4.0 + j as f64
 }
 
-/// Heights of the start, in σ_h, over which G1 is averaged (a rule in `[−4.5, 4.5]` of step ½,
-/// Simpson-weighted by φ(h)).
-pub const HEIGHT_NODES: usize = 19;
+/// Heights of the start, in σ_h, over which G1 is averaged (a rule in `[−4.5, 4.5]` of step 1,
+/// trapezoid-weighted by φ(h)).
+pub const HEIGHT_NODES: usize = 10;
 
 /// The ray is followed until it is this many σ_h above the mean plane, where nothing crosses it
 /// (Φ(6) = 1 − 1e-9).
@@ -101,44 +101,44 @@ impl LineProcess {
     }
 }
 
-/// The masking of [`conditioned_masking`]: by slope, averaged over heights, and by height,
-/// averaged over the visible slopes.
+/// The masking of [`conditioned_masking`] by slope, averaged over heights.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ConditionedMasking {
     /// `E_h₀[G1(h₀, z)]` at the slopes of [`slope_node`] (0 on back faces).
     pub slopes: [f64; SLOPE_NODES],
-    /// `E_z[G1(h, z)] / Φ(h)^Λ` at the heights of [`height_node`], z over the visible slopes
-    /// `∝ (ν − z)⁺φ(z)` and Λ Smith's for the same ray (`Λ(ν/√2)`): how the conditioned
-    /// height dependence departs from Smith's, to reweight D_h.
-    pub heights: [f64; HEIGHT_NODES],
 }
 
-/// Height of node `i` of [`HEIGHT_NODES`], in σ_h: `−4.5 + i/2`.
+impl ConditionedMasking {
+    /// No conditioning: 1 on the front slopes (`z < ν`), 0 behind.
+    pub fn none(nu: f64) -> Self {
+        let mut slopes = [0.0; SLOPE_NODES];
+        for (j, o) in slopes.iter_mut().enumerate() {
+            *o = if slope_node(j) < nu { 1.0 } else { 0.0 };
+        }
+        Self { slopes }
+    }
+}
+
+/// Height of node `i` of [`HEIGHT_NODES`], in σ_h: `−4.5 + i`.
 pub fn height_node(i: usize) -> f64 {
-    -4.5 + 0.5 * i as f64
+    -4.5 + i as f64
 }
 
 /// `E_h₀[G1(h₀, t)]` at the slopes `t = z_j σ_t` of [`slope_node`], for a ray of slope `ν = μ/σ_t`
 /// over `process` (module docs): h₀ ~ N(0, 1), independent of t at the same point. Back faces
 /// (`z ≥ ν`) get 0. Up to a constant this is the factor by which the visible slopes are reweighted.
-/// Also the height profile ([`ConditionedMasking::heights`]).
 ///
 /// Edge cases: `ν ≤ 0` or NaN (the ray never leaves the surface) gives all zeros; `ν ≥ 8` (no
-/// masking within 8 slope deviations) gives 1 at every front slope. Always finite, in [0, 1] (the
-/// height ratios ≥ 0).
+/// masking within 8 slope deviations) gives 1 at every front slope. Always finite, in [0, 1].
 pub fn conditioned_masking(process: &LineProcess, nu: f64) -> ConditionedMasking {
     let mut out = ConditionedMasking {
         slopes: [0.0; SLOPE_NODES],
-        heights: [1.0; HEIGHT_NODES],
     };
     if !(nu > 0.0) {
         return out;
     }
     if nu >= 8.0 {
-        for (j, o) in out.slopes.iter_mut().enumerate() {
-            *o = if slope_node(j) < nu { 1.0 } else { 0.0 };
-        }
-        return out;
+        return ConditionedMasking::none(nu);
     }
     // τ grid: fine enough for the highest frequency, long enough for the lowest start to climb to
     // TOP.
@@ -151,27 +151,13 @@ pub fn conditioned_masking(process: &LineProcess, nu: f64) -> ConditionedMasking
     let grid: Vec<(f64, f64, f64)> = (0..steps)
         .map(|i| process.at((i as f64 + 0.5) * dt))
         .collect();
-    let simpson = |i: usize, n: usize| {
-        if i == 0 || i == n - 1 {
-            1.0
-        } else if i % 2 == 1 {
-            4.0
-        } else {
-            2.0
-        }
-    };
     let hw: Vec<f64> = (0..HEIGHT_NODES)
-        .map(|i| simpson(i, HEIGHT_NODES) * norm_pdf(height_node(i)))
-        .collect();
-    let hsum: f64 = hw.iter().sum();
-    let zw: Vec<f64> = (0..SLOPE_NODES)
-        .map(|j| {
-            let z = slope_node(j);
-            simpson(j, SLOPE_NODES) * norm_pdf(z) * (nu - z).max(0.0)
+        .map(|i| {
+            let end = i == 0 || i == HEIGHT_NODES - 1;
+            (if end { 0.5 } else { 1.0 }) * norm_pdf(height_node(i))
         })
         .collect();
-    let zsum: f64 = zw.iter().sum();
-    let mut by_height = [0.0; HEIGHT_NODES];
+    let hsum: f64 = hw.iter().sum();
     for (j, o) in out.slopes.iter_mut().enumerate() {
         let t = slope_node(j);
         if t >= nu {
@@ -179,19 +165,9 @@ pub fn conditioned_masking(process: &LineProcess, nu: f64) -> ConditionedMasking
         }
         let mut acc = 0.0;
         for (i, w) in hw.iter().enumerate() {
-            let g = g1(&grid, dt, height_node(i), t, nu);
-            acc += w * g;
-            by_height[i] += zw[j] * g;
+            acc += w * g1(&grid, dt, height_node(i), t, nu);
         }
         *o = (acc / hsum).clamp(0.0, 1.0);
-    }
-    let lambda = crate::math::special::smith_lambda(nu / std::f64::consts::SQRT_2);
-    if zsum > 0.0 {
-        for (i, o) in out.heights.iter_mut().enumerate() {
-            let smith = norm_cdf(height_node(i)).powf(lambda);
-            let r = by_height[i] / zsum / smith.max(1e-300);
-            *o = if r.is_finite() { r.max(0.0) } else { 0.0 };
-        }
     }
     out
 }
@@ -233,7 +209,7 @@ fn g1(grid: &[(f64, f64, f64)], dt: f64, h0: f64, t: f64, nu: f64) -> f64 {
 /// the end nodes; NaN gives the profile's value at 0.
 pub fn profile_at(profile: &[f64; SLOPE_NODES], z: f64) -> f64 {
     let z = if z.is_nan() { 0.0 } else { z };
-    let x = ((z + 4.0) * 2.0).clamp(0.0, (SLOPE_NODES - 1) as f64);
+    let x = (z + 4.0).clamp(0.0, (SLOPE_NODES - 1) as f64);
     let i = (x as usize).min(SLOPE_NODES - 2);
     let f = x - i as f64;
     profile[i] * (1.0 - f) + profile[i + 1] * f
@@ -320,8 +296,6 @@ mod tests {
                     .iter()
                     .all(|v| v.is_finite() && (0.0..=1.0).contains(v))
             );
-            let prof = c.heights;
-            assert!(prof.iter().all(|v| v.is_finite() && *v >= 0.0));
         }
         let prof = conditioned_masking(&p, 1.0).slopes;
         for z in [f64::NAN, -1e9, -4.0, 0.3, 4.0, 1e9] {

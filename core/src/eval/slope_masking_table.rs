@@ -1,0 +1,210 @@
+//! A noise material's table of slope-conditioned masking ([`conditioned_masking`], #17): the
+//! profiles over the ray's azimuth, the footprint's scale and the ray's slope ν, in f32 as the GPU
+//! reads them. Core's filtered model looks up the same values, so the views and core agree; the
+//! direct computation stays the definition of each entry (tested against the lookup between
+//! nodes).
+//!
+//! Axes:
+//! - **azimuth** φ of the ray's horizontal direction, [`TABLE_AZIMUTHS`] nodes over [0, π)
+//!   (periodic: the process along −d is the one along d, and the slope is measured along the ray);
+//! - **level**: the footprint's standard deviation along the ray's azimuth, `r = √(dᵀΣ_p d)`, on
+//!   [`TABLE_LEVELS`] geometric nodes from `r₀ = 1/|k|_min` (every wave unresolved to 3e-9) down
+//!   to `0.1/|k|_max`; each node's process is what an isotropic footprint of that r leaves,
+//!   `½a_i²(1 − g_i²)` (`g_i = exp(−2π²|k_i|²r²)`). Between nodes, linear in ln r; clamped at the
+//!   ends;
+//! - **ν** = μ/σ_t, [`TABLE_NUS`] nodes `NU_MIN·NU_RATIO^j` (0.08 to 6.9), linear in ln ν, clamped.
+
+use crate::driver::noise::SumOfSines;
+use crate::microfacet::slope_masking::{
+    ConditionedMasking, LineProcess, SLOPE_NODES, conditioned_masking,
+};
+use glam::DVec2;
+use rayon::prelude::*;
+use std::f64::consts::{PI, TAU};
+
+/// Azimuth nodes over [0, π).
+pub const TABLE_AZIMUTHS: usize = 8;
+/// Footprint-scale nodes.
+pub const TABLE_LEVELS: usize = 8;
+/// ν nodes.
+pub const TABLE_NUS: usize = 12;
+/// The smallest ν node.
+pub const NU_MIN: f64 = 0.08;
+/// The ratio of successive ν nodes.
+pub const NU_RATIO: f64 = 1.5;
+/// f32 values per entry: the slope profile.
+pub const ENTRY: usize = SLOPE_NODES;
+
+/// The table (module docs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SlopeMaskingTable {
+    /// The footprint scale of level 0.
+    pub r0: f64,
+    /// ln of the ratio of successive levels' scales (> 0).
+    pub level_step: f64,
+    /// `ENTRY` values per (azimuth, level, ν), ν fastest.
+    pub data: Vec<f32>,
+}
+
+impl SlopeMaskingTable {
+    /// Tabulate the noise's profiles (in parallel over azimuths and levels). `None` without waves.
+    pub fn new(noise: &SumOfSines) -> Option<Self> {
+        let (k_min, k_max) = noise
+            .waves
+            .iter()
+            .map(|w| w.k.length())
+            .filter(|k| k.is_finite() && *k > 0.0)
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), k| {
+                (lo.min(k), hi.max(k))
+            });
+        if !(k_min.is_finite() && k_max > 0.0) {
+            return None;
+        }
+        let r0 = 1.0 / k_min;
+        let r_last = 0.1 / k_max;
+        let level_step = ((r0 / r_last).ln() / (TABLE_LEVELS - 1) as f64).max(1e-3);
+        let rows: Vec<Vec<f32>> = (0..TABLE_AZIMUTHS * TABLE_LEVELS)
+            .into_par_iter()
+            .map(|row| {
+                let (a, l) = (row / TABLE_LEVELS, row % TABLE_LEVELS);
+                let dir = DVec2::from_angle(PI * a as f64 / TABLE_AZIMUTHS as f64);
+                let r = r0 * (-(l as f64) * level_step).exp();
+                let process = LineProcess::new(noise.waves.iter().map(|w| {
+                    let g = (-2.0 * PI * PI * w.k.length_squared() * r * r).exp();
+                    (
+                        0.5 * w.amplitude * w.amplitude * (1.0 - g * g).max(0.0),
+                        TAU * w.k.dot(dir),
+                    )
+                }));
+                let mut out = Vec::with_capacity(TABLE_NUS * ENTRY);
+                for j in 0..TABLE_NUS {
+                    let c = match &process {
+                        Some(p) => conditioned_masking(p, nu_node(j)),
+                        None => ConditionedMasking::none(nu_node(j)),
+                    };
+                    out.extend(c.slopes.iter().map(|v| *v as f32));
+                }
+                out
+            })
+            .collect();
+        Some(Self {
+            r0,
+            level_step,
+            data: rows.concat(),
+        })
+    }
+
+    /// The profiles for a ray of horizontal direction `dir` (unit), a footprint of standard
+    /// deviation `r` along it and slope `nu`: multilinear between the nodes (module docs).
+    /// Non-finite inputs are clamped to the first nodes.
+    pub fn lookup(&self, dir: DVec2, r: f64, nu: f64) -> ConditionedMasking {
+        let (a0, a1, fa) = azimuth_coordinate(dir);
+        let lv = if r > 0.0 && r.is_finite() {
+            ((self.r0 / r).ln() / self.level_step).clamp(0.0, (TABLE_LEVELS - 1) as f64)
+        } else if r > 0.0 {
+            0.0
+        } else {
+            (TABLE_LEVELS - 1) as f64
+        };
+        let nv = if nu > 0.0 && nu.is_finite() {
+            ((nu / NU_MIN).ln() / NU_RATIO.ln()).clamp(0.0, (TABLE_NUS - 1) as f64)
+        } else if nu > 0.0 {
+            (TABLE_NUS - 1) as f64
+        } else {
+            0.0
+        };
+        let (l0, fl) = split(lv, TABLE_LEVELS);
+        let (n0, fn_) = split(nv, TABLE_NUS);
+        let mut acc = [0.0f64; ENTRY];
+        for (a, wa) in [(a0, 1.0 - fa), (a1, fa)] {
+            for (l, wl) in [(l0, 1.0 - fl), (l0 + 1, fl)] {
+                for (n, wn) in [(n0, 1.0 - fn_), (n0 + 1, fn_)] {
+                    let w = wa * wl * wn;
+                    if w == 0.0 {
+                        continue;
+                    }
+                    let base = ((a * TABLE_LEVELS + l) * TABLE_NUS + n) * ENTRY;
+                    for (o, v) in acc.iter_mut().zip(&self.data[base..base + ENTRY]) {
+                        *o += w * f64::from(*v);
+                    }
+                }
+            }
+        }
+        ConditionedMasking { slopes: acc }
+    }
+}
+
+/// ν of node `j`.
+pub fn nu_node(j: usize) -> f64 {
+    NU_MIN * NU_RATIO.powi(j as i32)
+}
+
+/// The two azimuth nodes around `dir` and the weight of the second (periodic over π).
+fn azimuth_coordinate(dir: DVec2) -> (usize, usize, f64) {
+    let phi = dir.y.atan2(dir.x).rem_euclid(PI);
+    let x = if phi.is_finite() {
+        phi / PI * TABLE_AZIMUTHS as f64
+    } else {
+        0.0
+    };
+    let i = (x.floor() as usize).min(TABLE_AZIMUTHS - 1);
+    let f = (x - i as f64).clamp(0.0, 1.0);
+    (i, (i + 1) % TABLE_AZIMUTHS, f)
+}
+
+/// A clamped coordinate in `[0, n − 1]` as the lower node (at most n − 2) and the fraction.
+fn split(x: f64, n: usize) -> (usize, f64) {
+    let i = (x as usize).min(n - 2);
+    (i, x - i as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::test_materials::preset;
+
+    #[test]
+    fn the_lookup_between_nodes_follows_the_direct_profile() {
+        let m = preset("snake-skin");
+        let noise = m.noise().expect("noise");
+        let t0 = std::time::Instant::now();
+        let table = SlopeMaskingTable::new(&noise).expect("table");
+        eprintln!("table built in {:.0} ms", t0.elapsed().as_secs_f64() * 1e3);
+        // Off every node: an azimuth between two, a footprint between levels, ν between nodes.
+        for (phi, level, nu) in [(0.3, 0.0, 0.5), (1.9, 2.5, 1.1), (2.9, 5.3, 0.25)] {
+            let dir = DVec2::from_angle(phi);
+            let r = table.r0 * (-level * table.level_step).exp();
+            let process = LineProcess::new(noise.waves.iter().map(|w| {
+                let g = (-2.0 * PI * PI * w.k.length_squared() * r * r).exp();
+                (
+                    0.5 * w.amplitude * w.amplitude * (1.0 - g * g),
+                    TAU * w.k.dot(dir),
+                )
+            }))
+            .expect("process");
+            let direct = conditioned_masking(&process, nu);
+            let looked = table.lookup(dir, r, nu);
+            // Compare on the front slopes, relative to the profile's mean there (only the shape
+            // is used).
+            let front: Vec<usize> = (0..SLOPE_NODES)
+                .filter(|j| crate::microfacet::slope_masking::slope_node(*j) < nu - 0.5)
+                .collect();
+            let mean = |p: &[f64; SLOPE_NODES]| {
+                front.iter().map(|j| p[*j]).sum::<f64>() / front.len() as f64
+            };
+            let (md, ml) = (mean(&direct.slopes), mean(&looked.slopes));
+            for j in &front {
+                let (d, l) = (direct.slopes[*j] / md, looked.slopes[*j] / ml);
+                assert!(
+                    (d - l).abs() < 0.06,
+                    "φ {phi}, level {level}, ν {nu}, z {}: direct {d:.3}, table {l:.3}",
+                    crate::microfacet::slope_masking::slope_node(*j)
+                );
+            }
+        }
+        // Every entry is finite and in range.
+        assert!(table.data.iter().all(|v| v.is_finite() && *v >= 0.0));
+        let c = table.lookup(DVec2::new(f64::NAN, 1.0), f64::NAN, f64::NAN);
+        assert!(c.slopes.iter().all(|v| v.is_finite()));
+    }
+}
