@@ -8,11 +8,13 @@ use crate::gpu_types::{GpuStruct, MaterialParams};
 use lodestone_core::driver::conditional_slopes;
 use lodestone_core::driver::histogram::G_END;
 use lodestone_core::eval::lod_surface::LOD_SETTLE;
+use lodestone_core::eval::slope_masking_table;
 use lodestone_core::microfacet::effective_height::{
     FIT_ALPHA_MU, FIT_ALPHA_SIGMA, FIT_BETA_MU, FIT_BETA_SIGMA,
 };
 use lodestone_core::microfacet::height_mixture::{MAX_KNOT_EDGES, MIXTURE_BINS};
 use lodestone_core::microfacet::masking_shadowing::AZIMUTH_CORRELATION;
+use lodestone_core::microfacet::slope_masking;
 use lodestone_core::scene::bound_grid::GRID_MARGIN_F32;
 use lodestone_core::scene::field_grid::FIELD_SETTLE;
 use lodestone_core::scene::march::FAST_WIDTH_F32;
@@ -167,6 +169,10 @@ pub fn wgsl_prelude() -> &'static str {
                 "IMAGE_INVERSE_SIZE",
                 conditional_slopes::INVERSE_SIZE as u32,
             ),
+            ("SLOPE_NODES", slope_masking::SLOPE_NODES as u32),
+            ("TABLE_AZIMUTHS", slope_masking_table::TABLE_AZIMUTHS as u32),
+            ("TABLE_LEVELS", slope_masking_table::TABLE_LEVELS as u32),
+            ("TABLE_NUS", slope_masking_table::TABLE_NUS as u32),
         ];
         for (name, v) in sets.into_iter().flatten().chain(counts) {
             let _ = writeln!(s, "const {name}: u32 = {v}u;");
@@ -184,6 +190,8 @@ pub fn wgsl_prelude() -> &'static str {
             ("FIELD_SETTLE", FIELD_SETTLE),
             ("LOD_SETTLE", LOD_SETTLE),
             ("HISTOGRAM_G_END", G_END),
+            ("TABLE_NU_MIN", slope_masking_table::NU_MIN),
+            ("TABLE_NU_RATIO", slope_masking_table::NU_RATIO),
         ];
         for (name, v) in floats {
             let _ = writeln!(s, "const {name}: f32 = {:?};", v as f32);

@@ -314,10 +314,11 @@ gpu_struct! {
         lobe_offset: u32 => "u32",
         /// Number of fitted lobes (0 for the analytic BRDF).
         lobe_count: u32 => "u32",
-        /// Padding to WGSL's 16-byte struct size.
-        pad3: u32 => "u32",
-        /// Padding to WGSL's 16-byte struct size.
-        pad4: u32 => "u32",
+        /// Offset of the slope-conditioned masking table (core's
+        /// `eval::slope_masking_table::SlopeMaskingTable`: r0, the level step, then the profiles).
+        cm_offset: u32 => "u32",
+        /// 1 when the filtered view conditions masking on the slope (the table is present).
+        cm_on: u32 => "u32",
     }
 }
 

@@ -721,6 +721,14 @@ pub fn material_data_for(
             data.extend([z.x as f32, z.y as f32, *w as f32]);
         }
         mark(&data, start, "slope quadrature rule");
+        if let Some(t) = &prepared.slope_masking {
+            let start = data.len();
+            base.cm_offset = data.len() as u32;
+            base.cm_on = 1;
+            data.extend([t.r0 as f32, t.level_step as f32]);
+            data.extend(&t.data);
+            mark(&data, start, "slope-conditioned masking table");
+        }
         if m.transfer_mixture() {
             let n = bin_slope_points(m.filtering.slope_points, m.terms.slope.is_some());
             base.mix_points = n as u32;

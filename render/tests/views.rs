@@ -619,6 +619,61 @@ fn noise_slope_density_on_the_gpu_matches_core() {
     );
 }
 
+/// Slope-conditioned masking (#17) on the GPU equals core's, pixel by pixel, on a far grazing patch
+/// and on a near grazing view (footprints across the table's levels), and it changes the image.
+#[test]
+fn slope_conditioned_masking_on_the_gpu_matches_core() {
+    use lodestone_core::microfacet::slope_masking::SlopeMasking;
+    let Some(r) = renderer() else { return };
+    for (distance, fov, elevation) in [(2000.0, 2.0, 75.0), (4.0, 40.0, 80.0)] {
+        let camera = Camera {
+            elevation_deg: elevation,
+            azimuth_deg: 20.0,
+            distance,
+            target: [5.0, 3.0],
+            fov_deg: fov,
+        };
+        let scene = Scene {
+            camera,
+            light: direction(30f64.to_radians(), 0.4),
+            shape: Shape::Plane,
+        };
+        let (w, h) = (12, 8);
+        let mut sums = vec![];
+        for masking in [SlopeMasking::Conditioned, SlopeMasking::Smith] {
+            let mut m = preset("snake-skin.ron");
+            m.filtering.slope_masking = masking;
+            let p = Evaluator::new(&m).unwrap();
+            assert_eq!(p.slope_masking.is_some(), masking == SlopeMasking::Conditioned);
+            let gm = GpuMaterial::new(r.context(), &p, camera.target).expect("fits");
+            let img = r
+                .render(&gm, &scene, ViewMode::Filtered, (w, h), 1)
+                .expect("readback");
+            let mut sum = 0.0;
+            for y in 0..h {
+                for x in 0..w {
+                    let want = cpu_pixel(&p, &scene, ViewMode::Filtered, x, y, w, h);
+                    let got = img.rgb(x, y);
+                    for k in 0..3 {
+                        assert!(
+                            (f64::from(got[k]) - want[k]).abs() <= 5e-3 * want[k].abs() + 2e-4,
+                            "{masking:?}, distance {distance} ({x}, {y}): GPU {got:?}, core {want:?}"
+                        );
+                    }
+                    sum += want[0] + want[1] + want[2];
+                }
+            }
+            sums.push(sum);
+        }
+        assert!(
+            (sums[0] / sums[1] - 1.0).abs() > 0.01,
+            "distance {distance}: conditioned {} against Smith {}: no change",
+            sums[0],
+            sums[1]
+        );
+    }
+}
+
 /// Ground truth's squared sums (`ViewTarget::read_moments`) are the sums of the squares of the
 /// rays it accumulated: drawn one ray per pixel at a time, each ray's colour is the difference of
 /// consecutive sums, and its square is summed on the CPU (in f64) for comparison. A flat noise

@@ -143,9 +143,7 @@ pub struct Filtering {
     /// An image driver's footprint values: its own histogram (default) or the Gaussian.
     pub image_histogram: ImageHistogram,
     /// Masking and shadowing of the visible slopes: Smith's, or conditioned on the facet's slope
-    /// along the ray (#17). Core's filtered model only, so not read from presets (an unknown
-    /// field there) until the GPU views mirror it: `lodestone eval --slope-masking conditioned`.
-    #[serde(skip)]
+    /// along the ray (#17; noise drivers).
     pub slope_masking: SlopeMasking,
 }
 

@@ -198,7 +198,8 @@ fn g1(grid: &[(f64, f64, f64)], dt: f64, h0: f64, t: f64, nu: f64) -> f64 {
         let q = m2 / s2;
         let up = s2 * norm_pdf(q) + m2 * norm_cdf(q);
         integral += up * norm_pdf(z) / sh / below * dt;
-        if integral > 745.0 {
+        if integral > 40.0 {
+            // G1 < 5e-18: nothing of this start is seen.
             return 0.0;
         }
     }

@@ -41,9 +41,14 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
     }
     // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
     let s_mean = loc.stats.slope_mean;
-    let shading = visible_shading(s_mean, cov, wo_w, wi_w);
+    // Slope-conditioned masking (#17) reweights the visible slopes and the sun's lobe.
+    let weights = slope_weights(fp, s_mean, cov, wo_w, wi_w);
+    let shading = visible_shading(s_mean, cov, wo_w, wi_w, weights);
     let lit = sun_visible * vbar;
     var spec = specular_lobes(s_mean, cov, wo_w, wi_w);
+    if (weights.on) {
+        spec = spec * lobe_factor(weights, s_mean, cov, wo_w, wi_w, params.roughness, params.slope_rule_offset, params.slope_points);
+    }
     // The density ratio scales only the sun's specular term: skipped where it changes nothing.
     if (any(spec > vec3<f32>(0.0)) && lit > 0.0 && params.sun != 0.0) {
         spec = spec * lobe_density_ratio(fp, s_mean, wo_w, wi_w);

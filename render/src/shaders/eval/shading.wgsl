@@ -194,8 +194,8 @@ fn has_environment() -> bool {
 //#if relief
 // Evaluator::visible_shading: point_shading averaged on the nodes of D_s (visible_slope_nodes),
 // world slope space, slopes N(mean, cov).
-fn visible_shading(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> SlopeShading {
-    let sums = visible_shading_sums(mean, cov, wo, wi, params.slope_rule_offset, params.slope_points);
+fn visible_shading(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, weights: SlopeWeights) -> SlopeShading {
+    let sums = visible_shading_sums(mean, cov, wo, wi, params.slope_rule_offset, params.slope_points, weights);
     var acc = sums.s;
     if (sums.den > 0.0) {
         let inv = 1.0 / sums.den;
@@ -213,8 +213,10 @@ struct ShadingSums {
     den: f32,
 }
 
-// Evaluator::visible_shading_sums, on the n × n rule stored at `rule_off`.
-fn visible_shading_sums(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, rule_off: u32, points: u32) -> ShadingSums {
+// Evaluator::visible_shading_sums, on the n × n rule stored at `rule_off`; with slope-conditioned
+// weights (#17) each node × its masking factor, the sun's terms × the joint factor, rescaled to
+// the masking's total.
+fn visible_shading_sums(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, rule_off: u32, points: u32, weights: SlopeWeights) -> ShadingSums {
     let l = cholesky(cov);
     let nodes = points * points;
     var acc: SlopeShading;
@@ -223,20 +225,34 @@ fn visible_shading_sums(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3
     acc.env = vec3<f32>(0.0);
     acc.cs_env = vec3<f32>(0.0);
     var den = 0.0;
+    var den_sun = 0.0;
     for (var i = 0u; i < nodes; i = i + 1u) {
         let b = rule_off + 3u * i;
         let z = vec3<f32>(data[b], data[b + 1u], data[b + 2u]);
         let s = mean + vec2<f32>(l.x * z.x, l.y * z.x + l.z * z.y);
         let u = max(wo.z - s.x * wo.x - s.y * wo.y, 0.0);
-        let wt = z.z * u;
+        var wt = z.z * u;
         if (wt > 0.0) {
-            let p = point_shading(normal_of(s), wi);
-            acc.cos = acc.cos + wt * p.cos;
-            acc.cs_cos = acc.cs_cos + wt * p.cs_cos;
+            let n = normal_of(s);
+            var ws = wt;
+            if (weights.on) {
+                let c = slope_weights_at(weights, slope_of(n));
+                ws = wt * c.y;
+                wt = wt * c.x;
+            }
+            let p = point_shading(n, wi);
+            acc.cos = acc.cos + ws * p.cos;
+            acc.cs_cos = acc.cs_cos + ws * p.cs_cos;
             acc.env = acc.env + wt * p.env;
             acc.cs_env = acc.cs_env + wt * p.cs_env;
             den = den + wt;
+            den_sun = den_sun + ws;
         }
+    }
+    if (weights.on && den_sun > 0.0) {
+        let k = den / den_sun;
+        acc.cos = acc.cos * k;
+        acc.cs_cos = acc.cs_cos * k;
     }
     return ShadingSums(acc, den);
 }

@@ -1,0 +1,55 @@
+// Mirror of `core/src/eval/slope_masking_table.rs`: the material's table of slope-conditioned
+// masking (#17), at params.cm_offset: r0, the ln step between footprint levels, then
+// TABLE_AZIMUTHS × TABLE_LEVELS × TABLE_NUS profiles of SLOPE_NODES values (ν fastest).
+// `//#if feature` blocks are stripped by render/src/specialize.rs when a scene does not use the feature.
+
+//#if relief
+// SlopeMaskingTable::lookup: multilinear over the azimuth (periodic over π), ln r and ln ν,
+// clamped at the ends.
+fn slope_masking_lookup(dir: vec2<f32>, r: f32, nu: f32) -> array<f32, SLOPE_NODES> {
+    let base = params.cm_offset;
+    let r0 = data[base];
+    let level_step = data[base + 1u];
+    let pi = 3.14159265358979;
+    var phi = atan2(dir.y, dir.x);
+    if (phi < 0.0) {
+        phi = phi + pi;
+    }
+    if (phi >= pi) {
+        phi = phi - pi;
+    }
+    let xa = phi / pi * f32(TABLE_AZIMUTHS);
+    let a0 = min(u32(max(floor(xa), 0.0)), TABLE_AZIMUTHS - 1u);
+    let fa = clamp(xa - f32(a0), 0.0, 1.0);
+    let a1 = (a0 + 1u) % TABLE_AZIMUTHS;
+    var lv = f32(TABLE_LEVELS - 1u);
+    if (r > 0.0) {
+        lv = clamp(log(r0 / r) / level_step, 0.0, f32(TABLE_LEVELS - 1u));
+    }
+    var nv = 0.0;
+    if (nu > 0.0) {
+        nv = clamp(log(nu / TABLE_NU_MIN) / log(TABLE_NU_RATIO), 0.0, f32(TABLE_NUS - 1u));
+    }
+    let l0 = min(u32(lv), TABLE_LEVELS - 2u);
+    let fl = lv - f32(l0);
+    let n0 = min(u32(nv), TABLE_NUS - 2u);
+    let fn_ = nv - f32(n0);
+    var acc: array<f32, SLOPE_NODES>;
+    for (var k = 0u; k < 8u; k = k + 1u) {
+        let a = select(a0, a1, (k & 1u) != 0u);
+        let l = l0 + ((k >> 1u) & 1u);
+        let n = n0 + ((k >> 2u) & 1u);
+        let w = select(1.0 - fa, fa, (k & 1u) != 0u)
+            * select(1.0 - fl, fl, ((k >> 1u) & 1u) != 0u)
+            * select(1.0 - fn_, fn_, ((k >> 2u) & 1u) != 0u);
+        if (w == 0.0) {
+            continue;
+        }
+        let e = base + 2u + ((a * TABLE_LEVELS + l) * TABLE_NUS + n) * SLOPE_NODES;
+        for (var j = 0u; j < SLOPE_NODES; j = j + 1u) {
+            acc[j] = acc[j] + w * data[e + j];
+        }
+    }
+    return acc;
+}
+//#endif
