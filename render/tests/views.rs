@@ -644,7 +644,10 @@ fn slope_conditioned_masking_on_the_gpu_matches_core() {
             let mut m = preset("snake-skin.ron");
             m.filtering.slope_masking = masking;
             let p = Evaluator::new(&m).unwrap();
-            assert_eq!(p.slope_masking.is_some(), masking == SlopeMasking::Conditioned);
+            assert_eq!(
+                p.slope_masking.is_some(),
+                masking == SlopeMasking::Conditioned
+            );
             let gm = GpuMaterial::new(r.context(), &p, camera.target).expect("fits");
             let img = r
                 .render(&gm, &scene, ViewMode::Filtered, (w, h), 1)

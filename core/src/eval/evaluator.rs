@@ -126,7 +126,7 @@ impl Evaluator {
                     p.material.driver == material.driver && p.material.slopes == material.slopes
                 })
                 .and_then(|p| p.slope_masking.clone())
-                .or_else(|| SlopeMaskingTable::new(noise).map(Arc::new)),
+                .or_else(|| SlopeMaskingTable::shared(noise)),
             _ => None,
         };
         let g = material.heights.transfer.moments(0.0, 1.0);

@@ -84,7 +84,7 @@ impl Evaluator {
         };
         // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
         let mean = loc.stats.slope_mean;
-        let weights = self.slope_weights(cfg.footprint, mean, &sigma, cfg.wo, cfg.wi);
+        let weights = self.slope_weights(cfg.footprint, mean, &sigma, cfg.wo);
         // Slope-conditioned masking (#17) reweights the visible slopes and the sun's lobe.
         let shading = self.visible_shading(mean, &sigma, cfg.wo, cfg.wi, frame, weights.as_ref());
         let lit = sun_visible * vbar;

@@ -95,10 +95,9 @@ impl Evaluator {
 
     /// The sums [`Evaluator::visible_shading`] divides: each input weighted by the node's
     /// visible projected area, and the sum of those weights, on the rule of order `points`.
-    /// With slope-conditioned `weights` ([`SlopeWeights`]) each node's weight is also multiplied by
-    /// its masking factor, and the sun's terms by its shadowing factor too, renormalised so that
-    /// the sun's inputs stay averages over the visible slopes (the mean shadowing V̄ is applied
-    /// apart, and only its share among the slopes moves).
+    /// With slope-conditioned masking ([`SlopeWeights`]) each node's weight is also multiplied by
+    /// its masking factor (the mean visibility stays the views', only its share among the slopes
+    /// moves).
     #[allow(clippy::too_many_arguments)]
     pub(super) fn visible_shading_sums(
         &self,
@@ -111,26 +110,18 @@ impl Evaluator {
         weights: Option<&SlopeWeights>,
     ) -> (SlopeShading, f64) {
         let mut acc = SlopeShading::default();
-        let (mut den, mut den_sun) = (0.0, 0.0);
+        let mut den = 0.0;
         visible_slope_nodes(mean, sigma, wo, points, |n, w| {
-            let (o, oi) = weights.map_or((1.0, 1.0), |c| c.at(slope_of(n)));
-            let (w, ws) = (w * o, w * oi);
+            let w = w * weights.map_or(1.0, |c| c.at(slope_of(n)));
             den += w;
-            den_sun += ws;
             let p = self.point_shading(n, wi, frame);
-            acc.cos += ws * p.cos;
+            acc.cos += w * p.cos;
             for c in 0..3 {
-                acc.cs_cos[c] += ws * p.cs_cos[c];
+                acc.cs_cos[c] += w * p.cs_cos[c];
                 acc.env[c] += w * p.env[c];
                 acc.cs_env[c] += w * p.cs_env[c];
             }
         });
-        // The sun's sums carry the shadowing factor: rescale them to the masking's total.
-        if weights.is_some() && den_sun > 0.0 {
-            let k = den / den_sun;
-            acc.cos *= k;
-            acc.cs_cos = acc.cs_cos.map(|v| v * k);
-        }
         (acc, den)
     }
 

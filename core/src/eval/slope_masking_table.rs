@@ -16,11 +16,12 @@
 
 use crate::driver::noise::SumOfSines;
 use crate::microfacet::slope_masking::{
-    ConditionedMasking, LineProcess, SLOPE_NODES, conditioned_masking,
+    ConditionedMasking, LineProcess, ProcessGrid, SLOPE_NODES, conditioned_masking_on,
 };
 use glam::DVec2;
 use rayon::prelude::*;
 use std::f64::consts::{PI, TAU};
+use std::sync::{Arc, Mutex};
 
 /// Azimuth nodes over [0, π).
 pub const TABLE_AZIMUTHS: usize = 8;
@@ -46,7 +47,39 @@ pub struct SlopeMaskingTable {
     pub data: Vec<f32>,
 }
 
+/// Tables built in this process, by their waves (at most [`CACHE_SIZE`]; a material edited back
+/// and forth, and the tests' many evaluators of the same presets, build each once).
+static CACHE: Mutex<Vec<(Vec<u64>, Arc<SlopeMaskingTable>)>> = Mutex::new(Vec::new());
+
+/// Tables the process keeps ([`SlopeMaskingTable::shared`]).
+const CACHE_SIZE: usize = 16;
+
 impl SlopeMaskingTable {
+    /// [`SlopeMaskingTable::new`] through a process-wide cache keyed by the waves' exact values:
+    /// about a second of CPU saved for each material seen again.
+    pub fn shared(noise: &SumOfSines) -> Option<Arc<Self>> {
+        let key: Vec<u64> = noise
+            .waves
+            .iter()
+            .flat_map(|w| [w.k.x.to_bits(), w.k.y.to_bits(), w.amplitude.to_bits()])
+            .collect();
+        let lock = || {
+            CACHE
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+        };
+        if let Some((_, t)) = lock().iter().find(|(k, _)| *k == key) {
+            return Some(t.clone());
+        }
+        let table = Arc::new(Self::new(noise)?);
+        let mut cache = lock();
+        if cache.len() >= CACHE_SIZE {
+            cache.remove(0);
+        }
+        cache.push((key, table.clone()));
+        Some(table)
+    }
+
     /// Tabulate the noise's profiles (in parallel over azimuths and levels). `None` without waves.
     pub fn new(noise: &SumOfSines) -> Option<Self> {
         let (k_min, k_max) = noise
@@ -76,11 +109,12 @@ impl SlopeMaskingTable {
                         TAU * w.k.dot(dir),
                     )
                 }));
+                let grid = process.as_ref().map(|p| ProcessGrid::new(p, nu_node(0)));
                 let mut out = Vec::with_capacity(TABLE_NUS * ENTRY);
                 for j in 0..TABLE_NUS {
-                    let c = match &process {
-                        Some(p) => conditioned_masking(p, nu_node(j)),
-                        None => ConditionedMasking::none(nu_node(j)),
+                    let c = match &grid {
+                        Some(g) => conditioned_masking_on(g, nu_node(j)),
+                        None => ConditionedMasking::none(),
                     };
                     out.extend(c.slopes.iter().map(|v| *v as f32));
                 }
@@ -162,6 +196,7 @@ fn split(x: f64, n: usize) -> (usize, f64) {
 mod tests {
     use super::*;
     use crate::eval::test_materials::preset;
+    use crate::microfacet::slope_masking::conditioned_masking;
 
     #[test]
     fn the_lookup_between_nodes_follows_the_direct_profile() {

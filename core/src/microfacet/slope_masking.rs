@@ -22,16 +22,17 @@
 //! slope is `z = t/σ_t` and the ray's slope `ν = μ/σ_t`, with `σ_t = √λ₂` the slope's standard
 //! deviation along d; the result depends on the spectrum's shape alone, not on σ_h.
 
-use crate::math::special::{norm_cdf, norm_pdf};
+use crate::math::special::{log_norm_cdf, norm_cdf, norm_pdf};
 use serde::{Deserialize, Serialize};
 
 /// How the filtered view's masking and shadowing treat a facet's slope.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
 pub enum SlopeMasking {
     /// Smith's: visibility depends on the height alone (the papers' model).
-    #[default]
     Smith,
-    /// Conditioned on the slope along the ray ([`conditioned_masking`]); noise drivers only.
+    /// Conditioned on the slope along the ray ([`conditioned_masking`]; default); noise drivers
+    /// only (image drivers keep Smith's).
+    #[default]
     Conditioned,
 }
 
@@ -104,18 +105,16 @@ impl LineProcess {
 /// The masking of [`conditioned_masking`] by slope, averaged over heights.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ConditionedMasking {
-    /// `E_h₀[G1(h₀, z)]` at the slopes of [`slope_node`] (0 on back faces).
+    /// `E_h₀[G1(h₀, z)]` at the slopes of [`slope_node`] (back faces hold the last front value).
     pub slopes: [f64; SLOPE_NODES],
 }
 
 impl ConditionedMasking {
-    /// No conditioning: 1 on the front slopes (`z < ν`), 0 behind.
-    pub fn none(nu: f64) -> Self {
-        let mut slopes = [0.0; SLOPE_NODES];
-        for (j, o) in slopes.iter_mut().enumerate() {
-            *o = if slope_node(j) < nu { 1.0 } else { 0.0 };
+    /// No conditioning: 1 at every slope.
+    pub fn none() -> Self {
+        Self {
+            slopes: [1.0; SLOPE_NODES],
         }
-        Self { slopes }
     }
 }
 
@@ -126,11 +125,70 @@ pub fn height_node(i: usize) -> f64 {
 
 /// `E_h₀[G1(h₀, t)]` at the slopes `t = z_j σ_t` of [`slope_node`], for a ray of slope `ν = μ/σ_t`
 /// over `process` (module docs): h₀ ~ N(0, 1), independent of t at the same point. Back faces
-/// (`z ≥ ν`) get 0. Up to a constant this is the factor by which the visible slopes are reweighted.
+/// (`z ≥ ν`) hold the last front value. Up to a constant this is the factor by which the visible
+/// slopes are reweighted.
 ///
 /// Edge cases: `ν ≤ 0` or NaN (the ray never leaves the surface) gives all zeros; `ν ≥ 8` (no
-/// masking within 8 slope deviations) gives 1 at every front slope. Always finite, in [0, 1].
+/// masking within 8 slope deviations) gives 1 everywhere. Always finite, in [0, 1].
 pub fn conditioned_masking(process: &LineProcess, nu: f64) -> ConditionedMasking {
+    if !(nu > 0.0 && nu < 8.0) {
+        // Nothing to integrate: the edge cases of `conditioned_masking_on`.
+        return conditioned_masking_on(
+            &ProcessGrid {
+                dt: 1.0,
+                values: vec![],
+                memory: 0,
+            },
+            nu,
+        );
+    }
+    conditioned_masking_on(&ProcessGrid::new(process, nu), nu)
+}
+
+/// `(R̂, R̂′, R̂″)` of a process at the midpoints of a τ grid: fine enough for its highest
+/// frequency (step `min(0.1, 0.25/ω̂_max)`), long enough for the lowest start of a ray of slope
+/// `nu_min` to climb out of the surface (coarser when that would pass [`MAX_STEPS`]). One grid
+/// serves every ν ≥ `nu_min` ([`conditioned_masking_on`]).
+///
+/// Past `memory` steps the process has forgotten the start (|R̂|, |R̂′|, |R̂″| stay below
+/// [`MEMORY`] on the rest of the grid): the rate there is Smith's, unconditioned, and its integral
+/// to the end is closed, `−E[(h′ − ν)⁺]·ln Φ(r)/ν` from the ray's height r at the cut.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProcessGrid {
+    dt: f64,
+    values: Vec<(f64, f64, f64)>,
+    memory: usize,
+}
+
+/// Below this the process's correlation with the start is neglected ([`ProcessGrid`]).
+const MEMORY: f64 = 0.01;
+
+impl ProcessGrid {
+    /// The grid of `process` for rays of slope at least `nu_min` (> 0).
+    pub fn new(process: &LineProcess, nu_min: f64) -> Self {
+        let span = (TOP + 4.5) / nu_min.max(1e-3);
+        let mut dt = (0.25 / process.max_frequency().max(1.0)).min(0.1);
+        if span / dt > MAX_STEPS as f64 {
+            dt = span / MAX_STEPS as f64;
+        }
+        let steps = (span / dt).ceil() as usize;
+        let values: Vec<(f64, f64, f64)> = (0..steps)
+            .map(|i| process.at((i as f64 + 0.5) * dt))
+            .collect();
+        let mut memory = values.len();
+        while memory > 0 {
+            let (r, r1, r2) = values[memory - 1];
+            if r.abs().max(r1.abs()).max(r2.abs()) >= MEMORY {
+                break;
+            }
+            memory -= 1;
+        }
+        Self { dt, values, memory }
+    }
+}
+
+/// [`conditioned_masking`] on a grid built for rays at most as grazing as `nu`.
+pub fn conditioned_masking_on(grid: &ProcessGrid, nu: f64) -> ConditionedMasking {
     let mut out = ConditionedMasking {
         slopes: [0.0; SLOPE_NODES],
     };
@@ -138,19 +196,9 @@ pub fn conditioned_masking(process: &LineProcess, nu: f64) -> ConditionedMasking
         return out;
     }
     if nu >= 8.0 {
-        return ConditionedMasking::none(nu);
+        return ConditionedMasking::none();
     }
-    // τ grid: fine enough for the highest frequency, long enough for the lowest start to climb to
-    // TOP.
-    let span = (TOP + 4.5) / nu;
-    let mut dt = (0.25 / process.max_frequency().max(1.0)).min(0.1);
-    if span / dt > MAX_STEPS as f64 {
-        dt = span / MAX_STEPS as f64;
-    }
-    let steps = (span / dt).ceil() as usize;
-    let grid: Vec<(f64, f64, f64)> = (0..steps)
-        .map(|i| process.at((i as f64 + 0.5) * dt))
-        .collect();
+    let (dt, grid) = (grid.dt, &grid.values[..grid.memory]);
     let hw: Vec<f64> = (0..HEIGHT_NODES)
         .map(|i| {
             let end = i == 0 || i == HEIGHT_NODES - 1;
@@ -158,11 +206,17 @@ pub fn conditioned_masking(process: &LineProcess, nu: f64) -> ConditionedMasking
         })
         .collect();
     let hsum: f64 = hw.iter().sum();
-    for (j, o) in out.slopes.iter_mut().enumerate() {
+    for j in 0..SLOPE_NODES {
         let t = slope_node(j);
         if t >= nu {
+            // A back face: the clamped cosine and u⁺ already take it out; its factor holds the
+            // last front value, so that a profile used as a weight neither drops it from a
+            // normalisation (the light's: Smith's V̄ counts it) nor falls to 0 toward the
+            // silhouette between two nodes.
+            out.slopes[j] = if j > 0 { out.slopes[j - 1] } else { 1.0 };
             continue;
         }
+        let o = &mut out.slopes[j];
         let mut acc = 0.0;
         for (i, w) in hw.iter().enumerate() {
             acc += w * g1(&grid, dt, height_node(i), t, nu);
@@ -174,12 +228,12 @@ pub fn conditioned_masking(process: &LineProcess, nu: f64) -> ConditionedMasking
 
 /// `G1(h₀, t)` on the τ grid of `(R̂, R̂′, R̂″)` at the midpoints of steps `dt` (module docs).
 fn g1(grid: &[(f64, f64, f64)], dt: f64, h0: f64, t: f64, nu: f64) -> f64 {
-    let mut integral = 0.0;
+    let mut integral = 0.0f64;
     for (i, &(r, r1, r2)) in grid.iter().enumerate() {
         let tau = (i as f64 + 0.5) * dt;
         let ray = h0 + nu * tau;
         if ray > TOP {
-            break;
+            return (-integral).exp();
         }
         let mh = r * h0 - r1 * t;
         let mp = r1 * h0 - r2 * t;
@@ -203,6 +257,10 @@ fn g1(grid: &[(f64, f64, f64)], dt: f64, h0: f64, t: f64, nu: f64) -> f64 {
             return 0.0;
         }
     }
+    // The process has forgotten the start (or the grid ends): Smith's tail in closed form.
+    let ray = h0 + nu * grid.len() as f64 * dt;
+    let excess = norm_pdf(nu) - nu * norm_cdf(-nu);
+    integral -= excess.max(0.0) / nu * log_norm_cdf(ray);
     (-integral).exp()
 }
 

@@ -42,7 +42,7 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
     // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
     let s_mean = loc.stats.slope_mean;
     // Slope-conditioned masking (#17) reweights the visible slopes and the sun's lobe.
-    let weights = slope_weights(fp, s_mean, cov, wo_w, wi_w);
+    let weights = slope_weights(fp, s_mean, cov, wo_w);
     let shading = visible_shading(s_mean, cov, wo_w, wi_w, weights);
     let lit = sun_visible * vbar;
     var spec = specular_lobes(s_mean, cov, wo_w, wi_w);

@@ -214,8 +214,7 @@ struct ShadingSums {
 }
 
 // Evaluator::visible_shading_sums, on the n × n rule stored at `rule_off`; with slope-conditioned
-// weights (#17) each node × its masking factor, the sun's terms × the joint factor, rescaled to
-// the masking's total.
+// masking (#17) each node × its masking factor.
 fn visible_shading_sums(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, rule_off: u32, points: u32, weights: SlopeWeights) -> ShadingSums {
     let l = cholesky(cov);
     let nodes = points * points;
@@ -225,7 +224,6 @@ fn visible_shading_sums(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3
     acc.env = vec3<f32>(0.0);
     acc.cs_env = vec3<f32>(0.0);
     var den = 0.0;
-    var den_sun = 0.0;
     for (var i = 0u; i < nodes; i = i + 1u) {
         let b = rule_off + 3u * i;
         let z = vec3<f32>(data[b], data[b + 1u], data[b + 2u]);
@@ -234,25 +232,16 @@ fn visible_shading_sums(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3
         var wt = z.z * u;
         if (wt > 0.0) {
             let n = normal_of(s);
-            var ws = wt;
             if (weights.on) {
-                let c = slope_weights_at(weights, slope_of(n));
-                ws = wt * c.y;
-                wt = wt * c.x;
+                wt = wt * slope_weights_at(weights, slope_of(n));
             }
             let p = point_shading(n, wi);
-            acc.cos = acc.cos + ws * p.cos;
-            acc.cs_cos = acc.cs_cos + ws * p.cs_cos;
+            acc.cos = acc.cos + wt * p.cos;
+            acc.cs_cos = acc.cs_cos + wt * p.cs_cos;
             acc.env = acc.env + wt * p.env;
             acc.cs_env = acc.cs_env + wt * p.cs_env;
             den = den + wt;
-            den_sun = den_sun + ws;
         }
-    }
-    if (weights.on && den_sun > 0.0) {
-        let k = den / den_sun;
-        acc.cos = acc.cos * k;
-        acc.cs_cos = acc.cs_cos * k;
     }
     return ShadingSums(acc, den);
 }
