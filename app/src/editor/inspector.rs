@@ -20,6 +20,7 @@ use lodestone_core::microfacet::effective_height::HeightFilter;
 use lodestone_core::microfacet::height_mixture::TransferSlopes;
 use lodestone_core::microfacet::masking_shadowing::Correlation;
 use lodestone_core::microfacet::slope_density::NoiseSlopes;
+use lodestone_core::microfacet::slope_masking::SlopeMasking;
 use std::sync::Arc;
 
 /// UI state of the inspector.
@@ -817,6 +818,22 @@ fn filtering(ui: &mut Ui, f: &mut Filtering) -> bool {
         .on_hover_text("Density of the noise's unresolved slopes under the specular lobe: the sum of sinusoids' own (saddlepoint of its cumulant generating function, Σ ln I0; lighter tails than a Gaussian; a few Newton steps over the waves per pixel, most of what the filtered view costs over naive) or the Gaussian of the same covariance [HN12 Sec. 5.5]");
     if d != f.noise_slopes {
         f.noise_slopes = d;
+        changed = true;
+    }
+    let mut sm = f.slope_masking;
+    egui::ComboBox::from_label("Slope masking")
+        .selected_text(match sm {
+            SlopeMasking::Smith => "Smith",
+            SlopeMasking::Conditioned => "Conditioned on slope",
+        })
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut sm, SlopeMasking::Smith, "Smith");
+            ui.selectable_value(&mut sm, SlopeMasking::Conditioned, "Conditioned on slope");
+        })
+        .response
+        .on_hover_text("Masking of the visible slopes D_s: Smith's, where a facet's visibility depends on its height alone [HN12 Eqs. 4–6] (default), or conditioned on the facet's slope along the view (Smith's crossing rate with the surface conditioned on the start's height and slope through the noise's autocovariance; Rice, Smith 1967): facets facing the eye are seen more, those leaning to the silhouette less. Noise drivers; closes most of the grazing error with the light at the normal or on the viewer's side (snake-skin 75°: −9% → −0.7%), not with the light opposite (#17, docs/design.md). A table of about a second per noise");
+    if sm != f.slope_masking {
+        f.slope_masking = sm;
         changed = true;
     }
     let mut ih = f.image_histogram;

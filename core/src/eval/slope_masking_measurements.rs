@@ -428,3 +428,119 @@ fn slope_conditioned_gaussian() {
         }
     }
 }
+
+/// Does the shadowing of the seen points depend on their slope along the light's azimuth, and how
+/// much? Over points of the explicit surface (as `slope_conditioned_visibility`), the seen ones
+/// binned by t_i (slope along the light's azimuth, in its standard deviations): P(lit | seen, t_i)
+/// over P(lit | seen), against the height-averaged conditioned profile toward the light
+/// normalised over the seen points (what a product of masking and shadowing factors assumes).
+/// Also P(lit | seen, t_i) within two height bands. `cargo test --release -p lodestone-core --
+/// --ignored --nocapture slope_conditioned_shadowing`.
+#[test]
+#[ignore = "a measurement, prints a table"]
+fn slope_conditioned_shadowing() {
+    use crate::eval::test_materials::gaussian_material;
+    use crate::microfacet::slope_masking::{LineProcess, conditioned_masking, profile_at};
+    use crate::microfacet::slopes::normal_of;
+    let n_points = 200_000;
+    for (name, view, light, az) in [
+        ("gaussian", 75.0, 46.0, 180.0),
+        ("gaussian", 60.0, 46.0, 180.0),
+        ("gaussian", 75.0, 46.0, 0.0),
+        ("default", 85.0, 30.0, 180.0),
+    ] {
+        let m = if name == "gaussian" {
+            gaussian_material()
+        } else {
+            preset(name)
+        };
+        let p = Evaluator::new(&m).expect("prepared");
+        let s = &p.surface;
+        let noise = m.noise().expect("noise");
+        let wo = direction(f64::to_radians(view), 0.0);
+        let wi = direction(f64::to_radians(light), f64::to_radians(az));
+        let di = DVec2::new(wi.x, wi.y).normalize();
+        let sh = m.heights.sigma_h;
+        let process = LineProcess::new(
+            noise
+                .waves
+                .iter()
+                .map(|w| (0.5 * (sh * w.amplitude).powi(2), 2.0 * PI * w.k.dot(di))),
+        )
+        .expect("process");
+        let sd_t: f64 = noise
+            .waves
+            .iter()
+            .map(|w| 0.5 * (sh * w.amplitude * 2.0 * PI * w.k.dot(di)).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let sd_h: f64 = noise
+            .waves
+            .iter()
+            .map(|w| 0.5 * (sh * w.amplitude).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        let nu = wi.z / wi.x.hypot(wi.y) / sd_t;
+        let profile = conditioned_masking(&process, nu).slopes;
+        let mut rng = 3u64;
+        // Bins of z_i: (−∞,−1.5), (−1.5,−0.5), (−0.5,0.5), (0.5,1.5), (1.5,∞); and heights below
+        // and above the mean.
+        let (mut seen_w, mut lit_w, mut model_w) = ([0.0; 5], [0.0; 5], [0.0; 5]);
+        let (mut band_seen, mut band_lit) = ([[0.0; 5]; 2], [[0.0; 5]; 2]);
+        for _ in 0..n_points {
+            let Some(FrontPoint { x, h, grad, u, .. }) = front_point(s, wo, &mut rng) else {
+                continue;
+            };
+            let pt = DVec3::new(x.x, x.y, h);
+            if !s.sees(pt, wo) {
+                continue;
+            }
+            let n = normal_of(grad);
+            let lit = n.dot(wi) > 0.0 && s.sees(pt, wi);
+            let z = grad.dot(di) / sd_t;
+            let b = [-1.5, -0.5, 0.5, 1.5].iter().filter(|e| z > **e).count();
+            let band = usize::from(h > 0.0);
+            seen_w[b] += u;
+            band_seen[band][b] += u;
+            model_w[b] += u * profile_at(&profile, z);
+            // Self-shadowed facets (n·ωi ≤ 0) are not what the factor is about: count them lit
+            // when the ray clears, as Smith's V̄ does.
+            let clear = s.sees(pt, wi);
+            if clear {
+                lit_w[b] += u;
+                band_lit[band][b] += u;
+            }
+            let _ = lit;
+        }
+        let all_lit: f64 = lit_w.iter().sum::<f64>() / seen_w.iter().sum::<f64>();
+        let all_model: f64 = model_w.iter().sum::<f64>() / seen_w.iter().sum::<f64>();
+        let row = |num: &[f64; 5], den: &[f64; 5], k: f64| {
+            (0..5)
+                .map(|b| format!("{:.2}", num[b] / den[b].max(1e-300) / k))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        eprintln!(
+            "{name:9} view {view} light {light}/{az}: P(clear | seen) {all_lit:.3}, ν_i {nu:.2}, σ_h {sd_h:.3}"
+        );
+        eprintln!(
+            "    P(clear | seen, t_i)/P(clear | seen): truth {}",
+            row(&lit_w, &seen_w, all_lit)
+        );
+        eprintln!(
+            "    height-averaged profile (product model):  {}",
+            row(&model_w, &seen_w, all_model)
+        );
+        for band in 0..2 {
+            eprintln!(
+                "    heights {}: truth {}",
+                if band == 0 {
+                    "below the mean"
+                } else {
+                    "above the mean"
+                },
+                row(&band_lit[band], &band_seen[band], all_lit)
+            );
+        }
+    }
+}

@@ -28,11 +28,13 @@ use serde::{Deserialize, Serialize};
 /// How the filtered view's masking and shadowing treat a facet's slope.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
 pub enum SlopeMasking {
-    /// Smith's: visibility depends on the height alone (the papers' model).
-    Smith,
-    /// Conditioned on the slope along the ray ([`conditioned_masking`]; default); noise drivers
-    /// only (image drivers keep Smith's).
+    /// Smith's: visibility depends on the height alone (the papers' model; default).
     #[default]
+    Smith,
+    /// Masking conditioned on the slope along the view ([`conditioned_masking`]); noise drivers
+    /// only (image drivers keep Smith's). Not the default yet: see docs/design.md for where it
+    /// helps (grazing views, light at the normal or on the viewer's side) and where it does not
+    /// (light opposite the view, whose slope-conditioned shadowing is not modelled).
     Conditioned,
 }
 
@@ -219,7 +221,7 @@ pub fn conditioned_masking_on(grid: &ProcessGrid, nu: f64) -> ConditionedMasking
         let o = &mut out.slopes[j];
         let mut acc = 0.0;
         for (i, w) in hw.iter().enumerate() {
-            acc += w * g1(&grid, dt, height_node(i), t, nu);
+            acc += w * g1(grid, dt, height_node(i), t, nu);
         }
         *o = (acc / hsum).clamp(0.0, 1.0);
     }
