@@ -187,8 +187,14 @@ fn slope_conditioned_masking_prototype() {
         ("default", 85.0, 85.0, 0.0),
         ("snake-skin", 75.0, 30.0, 0.0),
         ("snow-under-sky", 85.0, 30.0, 0.0),
+        ("gaussian", 75.0, 46.0, 180.0),
+        ("gaussian", 60.0, 46.0, 180.0),
     ] {
-        let mut m = preset(name);
+        let mut m = if name == "gaussian" {
+            crate::eval::test_materials::gaussian_material()
+        } else {
+            preset(name)
+        };
         m.brdf.specular = 0.0;
         let p = Evaluator::new(&m).expect("prepared");
         let s = &p.surface;
