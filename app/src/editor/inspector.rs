@@ -831,7 +831,7 @@ fn filtering(ui: &mut Ui, f: &mut Filtering) -> bool {
             ui.selectable_value(&mut sm, SlopeMasking::Conditioned, "Conditioned on slope");
         })
         .response
-        .on_hover_text("Masking of the visible slopes D_s: Smith's, where a facet's visibility depends on its height alone [HN12 Eqs. 4–6] (default), or conditioned on the facet's slope along the view (Smith's crossing rate with the surface conditioned on the start's height and slope through the noise's autocovariance; Rice, Smith 1967): facets facing the eye are seen more, those leaning to the silhouette less. Noise drivers; closes most of the grazing error with the light at the normal or on the viewer's side (snake-skin 75°: −9% → −0.7%), not with the light opposite (#17, docs/design.md). A table of about a second per noise");
+        .on_hover_text("Masking of the visible slopes D_s: Smith's, where a facet's visibility depends on its height alone [HN12 Eqs. 4–6] (default), or conditioned on the facet's slope along the view (Smith's crossing rate with the surface conditioned on the start's height and slope through the noise's autocovariance; Rice, Smith 1967): facets facing the eye are seen more, those leaning to the silhouette less. Noise drivers; closes most of the grazing error with the light at the normal or on the viewer's side (snake-skin at 75°: from −9% to −0.7%), not with the light opposite (#17, docs/design.md). A table of about a second per noise");
     if sm != f.slope_masking {
         f.slope_masking = sm;
         changed = true;
