@@ -8,7 +8,7 @@ use crate::material::color_terms::Affine;
 use crate::material::measured::ChannelWeights;
 use crate::material::merl_fit::fresnel_factor;
 use crate::math::gaussian::cholesky;
-use crate::microfacet::brdf::{BaseBrdf, filtered_specular, lobe_posterior};
+use crate::microfacet::brdf::{BaseBrdf, filtered_specular, half_vector_posterior};
 use crate::microfacet::slopes::SlopeCov;
 use crate::microfacet::slopes::{normal_of, slope_of};
 use crate::microfacet::visible_slopes::visible_slope_nodes;
@@ -282,14 +282,10 @@ pub(super) fn facet_frame_factor(
     wo: DVec3,
     wi: DVec3,
 ) -> f64 {
-    if !(wo.z > 0.0 && wi.z > 0.0) {
+    let Some((post, cov)) = half_vector_posterior(mean, sigma, wo, wi, sigma_lobe) else {
         return 1.0;
-    }
+    };
     let h = (wo + wi).normalize();
-    if !(h.z > 1e-9) {
-        return 1.0;
-    }
-    let (post, cov) = lobe_posterior(mean, sigma, slope_of(h), sigma_lobe);
     let (a, b, c) = cholesky(cov.xx, cov.xy, cov.yy);
     const NODES: [(f64, f64); 3] = [
         (-1.732_050_807_568_877_2, 1.0 / 6.0),

@@ -11,7 +11,7 @@
 
 use crate::driver::footprint::Footprint;
 use crate::eval::Evaluator;
-use crate::microfacet::brdf::lobe_posterior;
+use crate::microfacet::brdf::half_vector_posterior;
 use crate::microfacet::slope_masking::{SLOPE_NODES, SlopeMasking, profile_at};
 use crate::microfacet::slopes::{SlopeCov, slope_of};
 use crate::microfacet::visible_slopes::visible_slope_nodes;
@@ -39,7 +39,7 @@ impl SlopeWeights {
     }
 
     /// The factor of the sun's specular lobe: the lobe's facets (slopes near the posterior mean
-    /// `s*` of [`lobe_posterior`], where the facet slopes meet the base lobe around the half
+    /// `s*` of [`crate::microfacet::brdf::lobe_posterior`], where the facet slopes meet the base lobe around the half
     /// vector) are seen with the factor at s*, against the visible slopes' mean of it,
     /// `c(s*)·E[u⁺]/E[u⁺c]` on the rule of order `points`. 1 where ωo or ωi is below the horizon
     /// or no half vector exists.
@@ -53,14 +53,9 @@ impl SlopeWeights {
         sigma_lobe: f64,
         points: usize,
     ) -> f64 {
-        if !(wo.z > 0.0 && wi.z > 0.0) {
+        let Some((post, _)) = half_vector_posterior(mean, sigma, wo, wi, sigma_lobe) else {
             return 1.0;
-        }
-        let h = (wo + wi).normalize();
-        if !(h.z > 1e-9) {
-            return 1.0;
-        }
-        let (post, _) = lobe_posterior(mean, sigma, slope_of(h), sigma_lobe);
+        };
         let (mut plain, mut weighted) = (0.0, 0.0);
         visible_slope_nodes(mean, sigma, wo, points, |n, w| {
             plain += w;

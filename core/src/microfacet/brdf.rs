@@ -168,6 +168,22 @@ pub fn lobe_posterior(
     )
 }
 
+/// [`lobe_posterior`] at the half vector of ωo and ωi: `None` when either is below the horizon
+/// or their half vector is not above it.
+pub fn half_vector_posterior(
+    mean: DVec2,
+    sigma: &SlopeCov,
+    wo: DVec3,
+    wi: DVec3,
+    roughness: f64,
+) -> Option<(DVec2, SlopeCov)> {
+    if !(wo.z > 0.0 && wi.z > 0.0) {
+        return None;
+    }
+    let h = (wo + wi).normalize();
+    (h.z > 1e-9).then(|| lobe_posterior(mean, sigma, slope_of(h), roughness))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -46,9 +46,11 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
     let shading = visible_shading(s_mean, cov, wo_w, wi_w, weights);
     let lit = sun_visible * vbar;
     var spec = specular_lobes(s_mean, cov, wo_w, wi_w);
+//#if specular|measured
     if (weights.on) {
         spec = spec * lobe_factor(weights, s_mean, cov, wo_w, wi_w, params.roughness, params.slope_rule_offset, params.slope_points);
     }
+//#endif
     // The density ratio scales only the sun's specular term: skipped where it changes nothing.
     if (any(spec > vec3<f32>(0.0)) && lit > 0.0 && params.sun != 0.0) {
         spec = spec * lobe_density_ratio(fp, s_mean, wo_w, wi_w);

@@ -50,6 +50,7 @@ fn slope_weights(fp: vec3<f32>, mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>) 
     return out;
 }
 
+//#if specular|measured
 // SlopeWeights::lobe_factor: the sun's lobe × the factor at its posterior slope over the factor's
 // visible mean.
 fn lobe_factor(w: SlopeWeights, mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, roughness: f32, rule_off: u32, points: u32) -> f32 {
@@ -79,4 +80,5 @@ fn lobe_factor(w: SlopeWeights, mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, 
     }
     return 1.0;
 }
+//#endif
 //#endif
