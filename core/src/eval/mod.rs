@@ -56,6 +56,8 @@ mod measurements;
 #[cfg(test)]
 mod slope_masking_measurements;
 #[cfg(test)]
+mod slope_weights_measurements;
+#[cfg(test)]
 pub(crate) mod test_materials;
 #[cfg(test)]
 mod tests;
