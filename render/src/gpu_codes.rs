@@ -206,6 +206,12 @@ pub fn wgsl_prelude() -> &'static str {
 mod tests {
     use super::*;
 
+    /// The WGSL packs a slope-masking profile in a 3 × 3 matrix (`microfacet/slope_masking.wgsl`).
+    #[test]
+    fn a_slope_masking_profile_fills_a_three_by_three_matrix() {
+        assert_eq!(slope_masking::SLOPE_NODES, 9);
+    }
+
     /// Every constant is declared once, and the f32 literals read back as the same f32.
     #[test]
     fn prelude_declares_each_constant_once() {

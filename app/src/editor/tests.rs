@@ -437,27 +437,6 @@ fn regenerate_app_screenshots() {
             h.step();
         }
     });
-    shoot("snake-skin-slope-masking", &|h| {
-        // Snake skin at 75° with the filtered view's masking conditioned on the facet's slope
-        // (Filtering → Slope masking), its error map against the truth.
-        let ctx = h.ctx.clone();
-        h.state_mut().open_path(&ctx, &preset("snake-skin.ron"));
-        let mut m = h.state().material().clone();
-        m.filtering.slope_masking =
-            lodestone_core::microfacet::slope_masking::SlopeMasking::Conditioned;
-        h.state_mut().doc.material = m;
-        let app = h.state_mut();
-        app.view.camera.elevation_deg = 75.0;
-        app.view.camera.distance = 6.0;
-        app.view.show_error = true;
-        app.view.error_scale = 0.15;
-        h.step();
-        h.step();
-        for header in ["Driver f", "Heights", "Slopes"] {
-            h.get_by_label(header).click_accesskit();
-            h.step();
-        }
-    });
     shoot("measured-plastic", &|h| {
         // A red plastic (GGX α 0.15 with Schlick's Fresnel), written in the MERL format, as the
         // measured base BRDF of the default preset's relief under a white colour map.

@@ -6,7 +6,7 @@
 //#if relief
 // SlopeMaskingTable::lookup: multilinear over the azimuth (periodic over π), ln r and ln ν,
 // clamped at the ends.
-fn slope_masking_lookup(dir: vec2<f32>, r: f32, nu: f32) -> array<f32, SLOPE_NODES> {
+fn slope_masking_lookup(dir: vec2<f32>, r: f32, nu: f32) -> SlopeProfile {
     let base = params.cm_offset;
     let r0 = data[base];
     let level_step = data[base + 1u];
@@ -34,7 +34,7 @@ fn slope_masking_lookup(dir: vec2<f32>, r: f32, nu: f32) -> array<f32, SLOPE_NOD
     let fl = lv - f32(l0);
     let n0 = min(u32(nv), TABLE_NUS - 2u);
     let fn_ = nv - f32(n0);
-    var acc: array<f32, SLOPE_NODES>;
+    var acc = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
     for (var k = 0u; k < 8u; k = k + 1u) {
         let a = select(a0, a1, (k & 1u) != 0u);
         let l = l0 + ((k >> 1u) & 1u);
@@ -47,9 +47,9 @@ fn slope_masking_lookup(dir: vec2<f32>, r: f32, nu: f32) -> array<f32, SLOPE_NOD
         }
         let e = base + 2u + ((a * TABLE_LEVELS + l) * TABLE_NUS + n) * SLOPE_NODES;
         for (var j = 0u; j < SLOPE_NODES; j = j + 1u) {
-            acc[j] = acc[j] + w * data[e + j];
+            acc[j / 3u][j % 3u] = acc[j / 3u][j % 3u] + w * data[e + j];
         }
     }
-    return acc;
+    return SlopeProfile(acc);
 }
 //#endif

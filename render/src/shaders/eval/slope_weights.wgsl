@@ -10,7 +10,7 @@ struct SlopeWeights {
     dir: vec2<f32>,
     mean: f32,
     sd: f32,
-    profile: array<f32, SLOPE_NODES>,
+    profile: SlopeProfile,
 }
 
 // SlopeWeights::at: the masking factor of a facet of slope s.
