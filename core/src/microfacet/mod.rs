@@ -12,6 +12,7 @@
 //! | D_s, the slope rule that runs | [`visible_slopes`] | [HNPN14 Sec. 5.2] |
 //! | slopes under a transfer curve: bins, masking | [`height_mixture`] | #17, Smith 1967 |
 //! | the noise's exact slope density (saddlepoint) | [`slope_density`] | #17, Daniels 1954 |
+//! | masking conditioned on the facet's slope | [`slope_masking`] | #17, Smith 1967, Rice |
 //! | base BRDF, filtered specular | [`brdf`] | [HN12 Sec. 5.5] |
 //! | a(h) = ā + a_s·s(h) | [`attribute`] | [HN12 Eq. 17] |
 

@@ -32,9 +32,10 @@ pub enum SlopeMasking {
     #[default]
     Smith,
     /// Masking conditioned on the slope along the view ([`conditioned_masking`]); noise drivers
-    /// only (image drivers keep Smith's). Not the default yet: see docs/design.md for where it
-    /// helps (grazing views, light at the normal or on the viewer's side) and where it does not
-    /// (light opposite the view, whose slope-conditioned shadowing is not modelled).
+    /// only (image drivers keep Smith's). Not the default yet: it helps at grazing views with the
+    /// light at the normal or on the viewer's side, and errs the other way with the light opposite,
+    /// where the colour of D_h and the shading of D_s, reweighted separately, miss that G1 couples
+    /// height and slope (docs/design.md).
     Conditioned,
 }
 
