@@ -1,4 +1,4 @@
-//! A noise material's table of slope-conditioned masking ([`conditioned_masking`], #17): the
+//! A noise material's table of slope-conditioned masking ([`crate::microfacet::slope_masking::conditioned_masking`], #17): the
 //! profiles over the ray's azimuth, the footprint's scale and the ray's slope ν, in f32 as the GPU
 //! reads them. Core's filtered model looks up the same values, so the views and core agree; the
 //! direct computation stays the definition of each entry (tested against the lookup between
