@@ -90,17 +90,14 @@ impl Evaluator {
             return None;
         }
         let dir = DVec2::new(wo.x, wo.y) / r;
-        let sd =
-            (sigma.xx * dir.x * dir.x + 2.0 * sigma.xy * dir.x * dir.y + sigma.yy * dir.y * dir.y)
-                .max(0.0)
-                .sqrt();
+        let sd = sigma.projected_std(dir.x, dir.y);
         if !(sd > 1e-12) {
             return None;
         }
         let m = mean.dot(dir);
         let nu = (wo.z / r - m) / sd;
         // The footprint's standard deviation along the view's azimuth picks the level.
-        let scale = dir.dot(footprint.cov * dir).max(0.0).sqrt();
+        let scale = SlopeCov::from_mat(footprint.cov).projected_std(dir.x, dir.y);
         Some(SlopeWeights {
             dir,
             mean: m,

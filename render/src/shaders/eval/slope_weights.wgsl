@@ -34,14 +34,14 @@ fn slope_weights(fp: vec3<f32>, mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>) 
         return out;
     }
     let dir = wo.xy / r;
-    let sd = sqrt(max(cov.x * dir.x * dir.x + 2.0 * cov.z * dir.x * dir.y + cov.y * dir.y * dir.y, 0.0));
+    let sd = projected_std(cov, dir.x, dir.y);
     if (!(sd > 1e-12)) {
         return out;
     }
     let m = dot(mean, dir);
     let nu = (wo.z / r - m) / sd;
     // The footprint's standard deviation along the view's azimuth picks the level.
-    let scale = sqrt(max(fp.x * dir.x * dir.x + 2.0 * fp.z * dir.x * dir.y + fp.y * dir.y * dir.y, 0.0));
+    let scale = projected_std(fp, dir.x, dir.y);
     out.on = true;
     out.dir = dir;
     out.mean = m;
