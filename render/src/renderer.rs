@@ -171,6 +171,9 @@ struct Layout {
 pub struct GpuMaterial {
     data: wgpu::Buffer,
     params: wgpu::Buffer,
+    /// The noise's waves as a uniform array of [`WAVE_TABLE_LEN`] `vec4`s (binding 9, zero-padded;
+    /// `driver/noise.wgsl`'s `wave_table`), bound where the pipeline has the noise driver.
+    waves: wgpu::Buffer,
     target: [f64; 2],
     /// The material's own features ([`FeatureSet::of_material`]).
     features: FeatureSet,
@@ -181,6 +184,29 @@ pub struct GpuMaterial {
     /// The explicit surface without its bound grid, to keep the eye above it
     /// ([`Surface::clear_camera`]).
     surface: Surface,
+}
+
+/// Entries of the uniform wave table (`driver/noise.wgsl`'s `wave_table`):
+/// [`lodestone_core::driver::noise::NoiseParams::MAX_COMPONENTS`] waves at most.
+pub const WAVE_TABLE_LEN: usize = 256;
+
+const _: () = assert!(
+    WAVE_TABLE_LEN >= lodestone_core::driver::noise::NoiseParams::MAX_COMPONENTS as usize,
+    "every wave fits the uniform table"
+);
+
+/// The uniform wave table: the waves as uploaded in the data buffer (k.x, k.y, amplitude, phase at
+/// the camera target), zero-padded to [`WAVE_TABLE_LEN`] (all zero without a noise driver).
+fn wave_table(data: &[f32], params: &MaterialParams) -> Vec<[f32; 4]> {
+    let mut table = vec![[0.0f32; 4]; WAVE_TABLE_LEN];
+    let first = params.waves_offset as usize;
+    let n = (params.wave_count as usize).min(WAVE_TABLE_LEN);
+    for (i, w) in table.iter_mut().enumerate().take(n) {
+        if let Some(src) = data.get(first + 4 * i..first + 4 * i + 4) {
+            w.copy_from_slice(src);
+        }
+    }
+    table
 }
 
 /// One view's render target: an accumulation buffer (linear RGB + sample count per pixel), ground
@@ -1047,9 +1073,18 @@ impl GpuMaterial {
         });
         ctx.queue
             .write_buffer(&params_buffer, 0, bytemuck::bytes_of(&params));
+        let waves = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("material waves"),
+            size: (WAVE_TABLE_LEN * 16) as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        ctx.queue
+            .write_buffer(&waves, 0, bytemuck::cast_slice(&wave_table(&data, &params)));
         Ok(Self {
             data: buffer,
             params: params_buffer,
+            waves,
             target,
             features,
             all_features,
@@ -1387,7 +1422,7 @@ impl Renderer {
                 params.radius = radius as f32;
             }
         }
-        let entries = [
+        let mut entries = vec![
             &material.params,
             &material.data,
             &target.accum,
@@ -1398,6 +1433,13 @@ impl Renderer {
             &target.cut,
             &target.work,
         ];
+        // The wave table exists in the shader only where the noise driver does (binding 9).
+        if material
+            .pipeline_features(scene)
+            .contains(Feature::NoiseDriver)
+        {
+            entries.push(&material.waves);
+        }
         let entries: Vec<wgpu::BindGroupEntry> = entries
             .iter()
             .enumerate()

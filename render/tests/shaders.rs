@@ -147,8 +147,7 @@ const MIRRORS: &[(&str, &str, &str, &str)] = &[
 #[rustfmt::skip]
 const GPU_ONLY: &[(&str, &str, &str)] = &[
     ("driver/noise.wgsl", "wave", "reads wave i from the data buffer"),
-    ("driver/noise.wgsl", "fill_wave_cache", "copies the waves into workgroup memory for the march loops"),
-    ("driver/noise.wgsl", "cached_wave", "reads wave i from workgroup memory"),
+    ("driver/noise.wgsl", "cached_wave", "reads wave i from the uniform wave table"),
     ("driver/image.wgsl", "image_level", "reads a pyramid level's record from the data buffer"),
     ("material/preconvolved.wgsl", "texel4", "reads a table texel from the data buffer"),
     ("eval/shading.wgsl", "has_environment", "the parameter flag for an environment"),

@@ -76,10 +76,7 @@ fn pcg(v: u32) -> u32 {
 
 
 @compute @workgroup_size(8, 8)
-fn view_main(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-//#if noise
-    fill_wave_cache(local, 64u);
-//#endif
+fn view_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     let listed = view_params.list_len > 0u;
     if (listed && view_params.phase == 1u) {
         sum_runs(gid.y * view_params.width + gid.x);

@@ -6,25 +6,20 @@ fn wave(i: u32) -> vec4<f32> {
     return texel4(params.waves_offset, i);
 }
 
-// The waves in workgroup memory, for the loops that run per march step (lod_prepare, lod_mean,
-// octave_march, wave_term): on llvmpipe the storage-buffer loads of every wave at every step cost
-// 20–30% of a view's frame (default preset, 96×64, 60°: naive 56 → 42 ms, truth 6.7 → 5.3 µs per
-// ray). Filled by fill_wave_cache at the start of view_main; entry points that do not fill it (the
-// exported snippet's eval_* functions) never reach these loops. GPU only.
-var<workgroup> wave_cache: array<vec4<f32>, 256>;
+// The waves again as a uniform array (binding 9, `GpuMaterial`'s wave buffer: the first 256 of
+// them, zero-padded), for the loops that run per march step (lod_prepare, lod_mean, octave_march,
+// wave_term). A loop's index is never "always uniform" to llvmpipe's compiler, and there it loads a
+// storage or workgroup array at such an index one lane at a time, in a branchy loop over the eight
+// lanes (gallivm's emit_load_mem); a uniform array at any index is one branch-free gather, and on a
+// GPU it is the constant cache's broadcast. Measured (default preset, 128², one run, 60°/80° ×
+// distances 1.5/6/40): naive 246–347 ms a frame from workgroup memory, see docs/design.md for the
+// uniform array's. Only view_main's passes bind it; the exported snippet's eval_* functions never
+// reach these loops. GPU only.
+@group(0) @binding(9) var<uniform> wave_table: array<vec4<f32>, 256>;
 
-// Copy the waves into wave_cache, `local` being the invocation's index in a workgroup of `size`;
-// every invocation must call it (it ends with a barrier). GPU only.
-fn fill_wave_cache(local: u32, size: u32) {
-    for (var k = local; k < min(params.wave_count, 256u); k = k + size) {
-        wave_cache[k] = wave(k);
-    }
-    workgroupBarrier();
-}
-
-// Wave i from wave_cache. GPU only.
+// Wave i from wave_table. GPU only.
 fn cached_wave(i: u32) -> vec4<f32> {
-    return wave_cache[i];
+    return wave_table[i];
 }
 
 // UNROLL. llvmpipe (Mesa's CPU driver, what tests and CI run on) ends every loop of a shader
@@ -34,7 +29,7 @@ fn cached_wave(i: u32) -> vec4<f32> {
 // of wrong pixels in runs of exactly 8 (355 of 100 000 pixels of snow-under-sky at 78°, for
 // example). The wave sums that run per march step take eight waves per iteration, which moves the
 // limit 8× further; real GPUs have no such limit.
-// Wave i's (value, gradient) at x, from wave_cache (value_and_gradient runs per step of the
+// Wave i's (value, gradient) at x, from wave_table (value_and_gradient runs per step of the
 // reference march and in ground-truth shading, in view_main only).
 fn wave_term(i: u32, x: vec2<f32>) -> vec3<f32> {
     let w = cached_wave(i);

@@ -312,6 +312,11 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
     let settle_f = FIELD_SETTLE * top;
     var may_settle = 0u;
     var skip = 0.0;
+    // The crossing's bracket [prev_t, t] is refined once, after the loop: a GPU (and llvmpipe,
+    // which runs every branch of an `if` under a mask) would otherwise carry the whole refinement
+    // inside every step.
+    var crossed = false;
+    var cross_gap = 0.0;
     for (var it = 0u; it < 20000u; it = it + 1u) {
         note_work(1u);
         let p = o + d * t;
@@ -379,7 +384,10 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
             }
             if (l == last && gap < 0.0) {
                 if (t > 0.0) {
-                    return refine(o, d, prev_t, prev_g, t, gap, lod, sf);
+                    crossed = true;
+                    cross_gap = gap;
+                    left = true;
+                    break;
                 }
                 // The origin is on the surface by contract: a negative gap here is rounding.
                 gap = 0.0;
@@ -406,6 +414,9 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
             }
         }
         note_cut(!left && l < levels);
+        if (crossed) {
+            break;
+        }
         if (!have) {
             return -1.0;
         }
@@ -434,6 +445,9 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
             continue;
         }
         t = t + max(best_s, min_step);
+    }
+    if (crossed) {
+        return refine(o, d, prev_t, prev_g, t, cross_gap, lod, sf);
     }
     // 20000 steps, or the loop was cut: the answer is not known.
     note_cut(true);
