@@ -173,6 +173,7 @@ pub fn wgsl_prelude() -> &'static str {
             ("TABLE_AZIMUTHS", slope_masking_table::TABLE_AZIMUTHS as u32),
             ("TABLE_LEVELS", slope_masking_table::TABLE_LEVELS as u32),
             ("TABLE_NUS", slope_masking_table::TABLE_NUS as u32),
+            ("DATA_ROW", crate::renderer::DATA_ROW),
         ];
         for (name, v) in sets.into_iter().flatten().chain(counts) {
             let _ = writeln!(s, "const {name}: u32 = {v}u;");

@@ -169,7 +169,9 @@ struct Layout {
 /// A material uploaded for the GPU: its data buffer and its parameters (both constant).
 #[derive(Debug)]
 pub struct GpuMaterial {
-    data: wgpu::Buffer,
+    /// The data's f32 words as the bits of an R32Uint texture, [`DATA_ROW`] a row (binding 1;
+    /// `shaders/data_texture.wgsl`).
+    data: wgpu::TextureView,
     params: wgpu::Buffer,
     /// The noise's waves as a uniform array of [`WAVE_TABLE_LEN`] `vec4`s (binding 9, zero-padded;
     /// `driver/noise.wgsl`'s `wave_table`), bound where the pipeline has the noise driver.
@@ -184,6 +186,52 @@ pub struct GpuMaterial {
     /// The explicit surface without its bound grid, to keep the eye above it
     /// ([`Surface::clear_camera`]).
     surface: Surface,
+}
+
+/// Words of the material's data per row of its texture (a power of two; `DATA_ROW` in WGSL).
+pub const DATA_ROW: u32 = 4096;
+
+const _: () = assert!(DATA_ROW.is_power_of_two());
+
+/// Bytes of material data `ctx`'s device can bind: [`DATA_ROW`] words a row, as many rows as
+/// its largest 2-D texture has.
+pub fn data_limit(ctx: &GpuContext) -> u64 {
+    u64::from(DATA_ROW) * 4 * u64::from(ctx.device.limits().max_texture_dimension_2d)
+}
+
+/// The material's data as an R32Uint texture of [`DATA_ROW`] words a row, the last row
+/// zero-padded. The caller has checked the size against [`data_limit`].
+fn data_texture(ctx: &GpuContext, data: &[f32]) -> wgpu::TextureView {
+    let row = DATA_ROW as usize;
+    let rows = data.len().div_ceil(row).max(1);
+    let mut words = data.to_vec();
+    words.resize(rows * row, 0.0);
+    let size = wgpu::Extent3d {
+        width: DATA_ROW,
+        height: rows as u32,
+        depth_or_array_layers: 1,
+    };
+    let texture = ctx.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("material data"),
+        size,
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::R32Uint,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    ctx.queue.write_texture(
+        texture.as_image_copy(),
+        bytemuck::cast_slice(&words),
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(DATA_ROW * 4),
+            rows_per_image: Some(rows as u32),
+        },
+        size,
+    );
+    texture.create_view(&wgpu::TextureViewDescriptor::default())
 }
 
 /// Entries of the uniform wave table (`driver/noise.wgsl`'s `wave_table`):
@@ -936,8 +984,13 @@ pub fn push_march_tables(
 
 /// Append the bound grid of `noise` around `centre` to `d` (the octave march's skips;
 /// [`lodestone_core::scene::bound_grid`]): the pyramid's levels one after the other, `[lo, hi]` per
-/// cell, in coordinates relative to `centre` like the waves.
+/// cell, in coordinates relative to `centre` like the waves. Nothing when the environment variable
+/// `LODESTONE_NO_GRID` is set (`grid_n` stays 0: no skips), so `lodestone bench` can time both on
+/// the same build.
 fn push_bound_grid(noise: &SumOfSines, centre: DVec2, d: &mut MaterialData) {
+    if std::env::var_os("LODESTONE_NO_GRID").is_some() {
+        return;
+    }
     let Some(grid) = BoundGrid::around(noise, centre, GPU_GRID_CELLS) else {
         return;
     };
@@ -999,7 +1052,7 @@ impl GpuMaterial {
     /// Upload a prepared material with coordinates relative to `target` (the camera target), with
     /// only the data its features use ([`material_data_for`]); drawn by pipelines specialised to
     /// the material and scene. [`RenderError::TooLarge`] (and nothing created) when the data
-    /// exceeds what the adapter can bind in one buffer.
+    /// exceeds what the adapter can bind in one texture ([`data_limit`]).
     pub fn new(
         ctx: &GpuContext,
         prepared: &Evaluator,
@@ -1042,7 +1095,7 @@ impl GpuMaterial {
         if data.is_empty() {
             data.push(0.0);
         }
-        let limit = storage_limit(ctx);
+        let limit = data_limit(ctx);
         let bytes = (data.len() * 4) as u64;
         if bytes > limit {
             let parts = segments
@@ -1057,14 +1110,7 @@ impl GpuMaterial {
                 hint: format!(" ({parts}); use smaller tables or a smaller image"),
             });
         }
-        let buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("material data"),
-            size: (data.len() * 4) as u64,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        ctx.queue
-            .write_buffer(&buffer, 0, bytemuck::cast_slice(&data));
+        let data_view = data_texture(ctx, &data);
         let params_buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("material params"),
             size: std::mem::size_of::<MaterialParams>() as u64,
@@ -1082,7 +1128,7 @@ impl GpuMaterial {
         ctx.queue
             .write_buffer(&waves, 0, bytemuck::cast_slice(&wave_table(&data, &params)));
         Ok(Self {
-            data: buffer,
+            data: data_view,
             params: params_buffer,
             waves,
             target,
@@ -1423,29 +1469,29 @@ impl Renderer {
             }
         }
         let mut entries = vec![
-            &material.params,
-            &material.data,
-            &target.accum,
-            &target.view,
-            &target.moments,
-            &target.order,
-            &target.scratch,
-            &target.cut,
-            &target.work,
+            material.params.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&material.data),
+            target.accum.as_entire_binding(),
+            target.view.as_entire_binding(),
+            target.moments.as_entire_binding(),
+            target.order.as_entire_binding(),
+            target.scratch.as_entire_binding(),
+            target.cut.as_entire_binding(),
+            target.work.as_entire_binding(),
         ];
         // The wave table exists in the shader only where the noise driver does (binding 9).
         if material
             .pipeline_features(scene)
             .contains(Feature::NoiseDriver)
         {
-            entries.push(&material.waves);
+            entries.push(material.waves.as_entire_binding());
         }
         let entries: Vec<wgpu::BindGroupEntry> = entries
-            .iter()
+            .into_iter()
             .enumerate()
-            .map(|(i, b)| wgpu::BindGroupEntry {
+            .map(|(i, resource)| wgpu::BindGroupEntry {
                 binding: i as u32,
-                resource: b.as_entire_binding(),
+                resource,
             })
             .collect();
         let bind = self

@@ -100,6 +100,25 @@ pub fn material() -> &'static str {
     &MATERIAL
 }
 
+/// How the views read the material's data: `shaders/data_texture.wgsl`, which replaces
+/// `bindings.wgsl`'s storage block in [`view_material`].
+pub const DATA_TEXTURE: &str = include_str!("shaders/data_texture.wgsl");
+
+/// The material unit as the views use it: [`material`] with the data read from a texture
+/// ([`DATA_TEXTURE`]) instead of the storage buffer the exported snippet binds.
+pub fn view_material() -> &'static str {
+    static VIEW_MATERIAL: LazyLock<String> = LazyLock::new(|| {
+        let m = material();
+        let begin = "// data-access: storage (begin)";
+        let end = "// data-access: storage (end)";
+        let (Some(a), Some(b)) = (m.find(begin), m.find(end)) else {
+            panic!("bindings.wgsl marks its storage block");
+        };
+        format!("{}{}{}", &m[..a], DATA_TEXTURE, &m[b + end.len()..])
+    });
+    &VIEW_MATERIAL
+}
+
 /// The view's parameters: the `ViewParams` struct (generated from
 /// [`crate::gpu_types::ViewParams`]) and its binding, read by the view and cylinder units.
 pub fn view_bindings() -> &'static str {
@@ -139,6 +158,7 @@ pub fn files() -> Vec<(&'static str, &'static str)> {
             include_str!("shaders/eval/cylinder.wgsl"),
         ),
         ("view.wgsl", VIEW),
+        ("data_texture.wgsl", DATA_TEXTURE),
     ]);
     v
 }
@@ -149,8 +169,14 @@ pub fn prelude_for(name: &str) -> Vec<&'static str> {
         // The material and the image driver call each other (module scope is order-free in WGSL).
         "material" => vec![SPECIAL, IMAGE_DRIVER],
         "image_driver" => vec![SPECIAL, material()],
-        "cylinder" => vec![SPECIAL, material(), IMAGE_DRIVER, view_bindings()],
-        "view" => vec![SPECIAL, material(), IMAGE_DRIVER, view_bindings(), CYLINDER],
+        "cylinder" => vec![SPECIAL, view_material(), IMAGE_DRIVER, view_bindings()],
+        "view" => vec![
+            SPECIAL,
+            view_material(),
+            IMAGE_DRIVER,
+            view_bindings(),
+            CYLINDER,
+        ],
         _ => vec![],
     }
 }

@@ -144,7 +144,7 @@ pub fn specialize(source: &str, features: FeatureSet) -> Result<String, Speciali
 pub fn view_source_for(features: FeatureSet) -> Result<String, SpecializeError> {
     use crate::shaders;
     let features = features.normalized();
-    let mut parts = vec![shaders::SPECIAL, shaders::material()];
+    let mut parts = vec![shaders::SPECIAL, shaders::view_material()];
     if features.contains(Feature::ImageDriver) {
         parts.push(shaders::IMAGE_DRIVER);
     }

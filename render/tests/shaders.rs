@@ -164,6 +164,8 @@ const GPU_ONLY: &[(&str, &str, &str)] = &[
     ("view.wgsl", "pixel_centre", "a pixel's centre from its index"),
     ("view.wgsl", "add_ray", "adds one ground-truth ray to a pixel's sums"),
     ("view.wgsl", "count_cut", "counts pixels or rays whose march loops the adapter cut"),
+    ("bindings.wgsl", "datum", "reads entry i of the material's data (the snippet's storage buffer)"),
+    ("data_texture.wgsl", "datum", "reads entry i of the material's data (the views' texture)"),
     ("bindings.wgsl", "note_cut", "records a loop the adapter cut (Mesa's loop limiter)"),
     ("bindings.wgsl", "note_work", "adds to a truth ray's work (its cost, for cost-aware adaptive plans)"),
 ];

@@ -16,7 +16,17 @@ const SQRT_2: f32 = 1.4142135;
 
 @group(0) @binding(0) var<storage, read> params: Params;
 
+// data-access: storage (begin)
+// The material's data (tables, grids, images) as a storage buffer: how the exported snippet reads
+// it. The views read the same words from a texture instead (`shaders::view_material`, which
+// replaces this block with `shaders/data_texture.wgsl`).
 @group(0) @binding(1) var<storage, read> data: array<f32>;
+
+// Entry i of the material's data. GPU only.
+fn datum(i: u32) -> f32 {
+    return data[i];
+}
+// data-access: storage (end)
 
 // GPU only. Set when a loop of the march stopped before its own condition ended it. Mesa's gallivm
 // (llvmpipe, lavapipe) caps every loop of a shader at 65535 iterations over a whole invocation of

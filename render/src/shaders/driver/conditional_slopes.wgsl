@@ -2,19 +2,19 @@
 // `//#if feature` blocks are stripped by render/src/specialize.rs when a scene does not use the feature.
 
 //#if transfer_mixture
-// lerp_table: the `len` values at data[off] read at fractional index x, linear between entries,
+// lerp_table: the `len` values at datum(off) read at fractional index x, linear between entries,
 // clamped to the ends (NaN: the first).
 fn lerp_table(off: u32, len: u32, x: f32) -> f32 {
     let last = len - 1u;
     if (!(x > 0.0)) {
-        return data[off];
+        return datum(off);
     }
     if (x >= f32(last)) {
-        return data[off + last];
+        return datum(off + last);
     }
     let i = min(u32(floor(x)), last - 1u);
     let a = x - f32(i);
-    return data[off + i] + a * (data[off + i + 1u] - data[off + i]);
+    return datum(off + i) + a * (datum(off + i + 1u) - datum(off + i));
 }
 
 // ImageSlopes::scale_at_gauss: s² at Gaussian-space value g (table at params.is_offset).

@@ -19,11 +19,11 @@ struct ImageLevel {
 fn image_level(l: u32) -> ImageLevel {
     let b = params.image_offset + 5u * min(l, params.image_levels - 1u);
     var r: ImageLevel;
-    r.value_offset = bitcast<u32>(data[b]);
-    r.grad_offset = bitcast<u32>(data[b + 1u]);
-    r.width = max(bitcast<u32>(data[b + 2u]), 1u);
-    r.height = max(bitcast<u32>(data[b + 3u]), 1u);
-    r.mean_variance = data[b + 4u];
+    r.value_offset = bitcast<u32>(datum(b));
+    r.grad_offset = bitcast<u32>(datum(b + 1u));
+    r.width = max(bitcast<u32>(datum(b + 2u)), 1u);
+    r.height = max(bitcast<u32>(datum(b + 3u)), 1u);
+    r.mean_variance = datum(b + 4u);
     return r;
 }
 
@@ -59,8 +59,8 @@ fn image_at_level(lv: ImageLevel, base: ImageLevel, p: vec2<f32>) -> vec2<f32> {
 }
 
 fn image_bilerp(off: u32, stride: u32, k: u32, c: ImageCell) -> f32 {
-    let top = mix(data[off + stride * c.i.x + k], data[off + stride * c.i.y + k], c.a.x);
-    let bot = mix(data[off + stride * c.i.z + k], data[off + stride * c.i.w + k], c.a.x);
+    let top = mix(datum(off + stride * c.i.x + k), datum(off + stride * c.i.y + k), c.a.x);
+    let bot = mix(datum(off + stride * c.i.z + k), datum(off + stride * c.i.w + k), c.a.x);
     return mix(top, bot, c.a.y);
 }
 
@@ -68,10 +68,10 @@ fn image_bilerp(off: u32, stride: u32, k: u32, c: ImageCell) -> f32 {
 fn image_value_and_gradient(p: vec2<f32>) -> vec3<f32> {
     let l = image_level(0u);
     let c = image_cell(l.width, l.height, p);
-    let f00 = data[l.value_offset + 2u * c.i.x];
-    let f10 = data[l.value_offset + 2u * c.i.y];
-    let f01 = data[l.value_offset + 2u * c.i.z];
-    let f11 = data[l.value_offset + 2u * c.i.w];
+    let f00 = datum(l.value_offset + 2u * c.i.x);
+    let f10 = datum(l.value_offset + 2u * c.i.y);
+    let f01 = datum(l.value_offset + 2u * c.i.z);
+    let f11 = datum(l.value_offset + 2u * c.i.w);
     let top = f00 + c.a.x * (f10 - f00);
     let bot = f01 + c.a.x * (f11 - f01);
     let fx = (f10 - f00) + c.a.y * ((f11 - f01) - (f10 - f00));

@@ -28,7 +28,7 @@ fn environment_at(nw: vec3<f32>) -> vec3<f32> {
     let b = array<f32, 9>(0.282095, 0.488603 * y, 0.488603 * z, 0.488603 * x, 1.092548 * x * y, 1.092548 * y * z, 0.315392 * (3.0 * z * z - 1.0), 1.092548 * x * z, 0.546274 * (x * x - y * y));
     var e = vec3<f32>(0.0);
     for (var i = 0u; i < 9u; i = i + 1u) {
-        e = e + b[i] * vec3<f32>(data[o + 3u * i], data[o + 3u * i + 1u], data[o + 3u * i + 2u]);
+        e = e + b[i] * vec3<f32>(datum(o + 3u * i), datum(o + 3u * i + 1u), datum(o + 3u * i + 2u));
     }
     return max(e, vec3<f32>(0.0));
 //#else
@@ -87,9 +87,9 @@ fn specular_lobes(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>)
         var out = vec3<f32>(0.0);
         for (var k = 0u; k < params.lobe_count; k = k + 1u) {
             let o = params.lobe_offset + 7u * k;
-            let sigma = data[o];
+            let sigma = datum(o);
             let v = filtered_lobe(1.0, sigma, mean, cov, wo, wi) * facet_frame_factor(sigma, mean, cov, wo, wi);
-            out = out + v * (vec3<f32>(data[o + 1u], data[o + 2u], data[o + 3u]) + vec3<f32>(data[o + 4u], data[o + 5u], data[o + 6u]) * f);
+            out = out + v * (vec3<f32>(datum(o + 1u), datum(o + 2u), datum(o + 3u)) + vec3<f32>(datum(o + 4u), datum(o + 5u), datum(o + 6u)) * f);
         }
         return out;
     }
@@ -110,8 +110,8 @@ fn facet_specular(n: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> vec3<f32> {
         var out = vec3<f32>(0.0);
         for (var k = 0u; k < params.lobe_count; k = k + 1u) {
             let o = params.lobe_offset + 7u * k;
-            let v = specular_lobe(1.0, data[o], vec3<f32>(0.0, 0.0, 1.0), wo_l, wi_l, vec3<f32>(0.0));
-            out = out + v * (vec3<f32>(data[o + 1u], data[o + 2u], data[o + 3u]) + vec3<f32>(data[o + 4u], data[o + 5u], data[o + 6u]) * f);
+            let v = specular_lobe(1.0, datum(o), vec3<f32>(0.0, 0.0, 1.0), wo_l, wi_l, vec3<f32>(0.0));
+            out = out + v * (vec3<f32>(datum(o + 1u), datum(o + 2u), datum(o + 3u)) + vec3<f32>(datum(o + 4u), datum(o + 5u), datum(o + 6u)) * f);
         }
         return out;
     }
@@ -226,7 +226,7 @@ fn visible_shading_sums(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3
     var den = 0.0;
     for (var i = 0u; i < nodes; i = i + 1u) {
         let b = rule_off + 3u * i;
-        let z = vec3<f32>(data[b], data[b + 1u], data[b + 2u]);
+        let z = vec3<f32>(datum(b), datum(b + 1u), datum(b + 2u));
         let s = mean + vec2<f32>(l.x * z.x, l.y * z.x + l.z * z.y);
         let u = max(wo.z - s.x * wo.x - s.y * wo.y, 0.0);
         var wt = z.z * u;

@@ -8,8 +8,8 @@
 // clamped at the ends.
 fn slope_masking_lookup(dir: vec2<f32>, r: f32, nu: f32) -> SlopeProfile {
     let base = params.cm_offset;
-    let r0 = data[base];
-    let level_step = data[base + 1u];
+    let r0 = datum(base);
+    let level_step = datum(base + 1u);
     let pi = 3.14159265358979;
     var phi = atan2(dir.y, dir.x);
     if (phi < 0.0) {
@@ -47,7 +47,7 @@ fn slope_masking_lookup(dir: vec2<f32>, r: f32, nu: f32) -> SlopeProfile {
         }
         let e = base + 2u + ((a * TABLE_LEVELS + l) * TABLE_NUS + n) * SLOPE_NODES;
         for (var j = 0u; j < SLOPE_NODES; j = j + 1u) {
-            acc[j / 3u][j % 3u] = acc[j / 3u][j % 3u] + w * data[e + j];
+            acc[j / 3u][j % 3u] = acc[j / 3u][j % 3u] + w * datum(e + j);
         }
     }
     return SlopeProfile(acc);

@@ -67,7 +67,7 @@ fn lobe_factor(w: SlopeWeights, mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, 
     var weighted = 0.0;
     for (var i = 0u; i < points * points; i = i + 1u) {
         let b = rule_off + 3u * i;
-        let z = vec3<f32>(data[b], data[b + 1u], data[b + 2u]);
+        let z = vec3<f32>(datum(b), datum(b + 1u), datum(b + 2u));
         let s = mean + vec2<f32>(l.x * z.x, l.y * z.x + l.z * z.y);
         let wt = z.z * max(wo.z - s.x * wo.x - s.y * wo.y, 0.0);
         if (wt > 0.0) {

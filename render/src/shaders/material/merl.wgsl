@@ -58,6 +58,6 @@ fn merl_eval(wi: vec3<f32>, wo: vec3<f32>) -> vec3<f32> {
     }
     let a = half_diff(wi, wo);
     let i = params.merl_offset + phi_d_index(a.z) + MERL_PHI_D_RES * (theta_d_index(a.y) + MERL_THETA_D_RES * theta_h_index(a.x));
-    return vec3<f32>(data[i], data[i + MERL_ENTRIES], data[i + 2u * MERL_ENTRIES]);
+    return vec3<f32>(datum(i), datum(i + MERL_ENTRIES), datum(i + 2u * MERL_ENTRIES));
 }
 //#endif

@@ -3,7 +3,7 @@
 
 fn texel4(off: u32, i: u32) -> vec4<f32> {
     let b = off + 4u * i;
-    return vec4<f32>(data[b], data[b + 1u], data[b + 2u], data[b + 3u]);
+    return vec4<f32>(datum(b), datum(b + 1u), datum(b + 2u), datum(b + 3u));
 }
 
 //#if driver_color|height_color|transfer_curve

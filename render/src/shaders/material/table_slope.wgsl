@@ -12,7 +12,7 @@ var<private> lod_g_lip: f32;
 // TableSlope::entry: level k's entry i of row j of the slope pyramids.
 fn table_slope_entry(j: u32, k: u32, i: u32) -> f32 {
     let p2 = 2u * params.ts_p;
-    return data[params.ts_offset + j * p2 + p2 - (p2 >> k) + i];
+    return datum(params.ts_offset + j * p2 + p2 - (p2 >> k) + i);
 }
 
 // TableSlope::at: the rows the transfer table's sampler blends at σ (split_coord as table_sample).

@@ -6,24 +6,24 @@
 fn poly_eval(off: u32, k: u32, channels: u32, ch: u32, x: f32) -> f32 {
     let coeff = off + k;
     let tails = coeff + 4u * channels * (k - 1u);
-    if (x < data[off]) {
-        return data[tails + ch];
+    if (x < datum(off)) {
+        return datum(tails + ch);
     }
-    if (x >= data[off + k - 1u]) {
-        return data[tails + channels + ch];
+    if (x >= datum(off + k - 1u)) {
+        return datum(tails + channels + ch);
     }
     // Last knot ≤ x.
     var seg = 0u;
     for (var i = 1u; i < k - 1u; i = i + 1u) {
-        if (data[off + i] <= x) {
+        if (datum(off + i) <= x) {
             seg = i;
         }
     }
-    let a = data[off + seg];
-    let b = data[off + seg + 1u];
+    let a = datum(off + seg);
+    let b = datum(off + seg + 1u);
     let t = (x - a) / (b - a);
     let c = coeff + 4u * (seg * channels + ch);
-    return ((data[c + 3u] * t + data[c + 2u]) * t + data[c + 1u]) * t + data[c];
+    return ((datum(c + 3u) * t + datum(c + 2u)) * t + datum(c + 1u)) * t + datum(c);
 }
 
 // PiecewisePoly::max_abs_on: the largest |p_ch| over [lo, hi] for a channel of degree ≤ 2 (interval
@@ -35,22 +35,22 @@ fn poly_max_abs_on(off: u32, k: u32, channels: u32, ch: u32, lo: f32, hi: f32) -
     let coeff = off + k;
     let tails = coeff + 4u * channels * (k - 1u);
     var best = 0.0;
-    if (lo < data[off]) {
-        best = abs(data[tails + ch]);
+    if (lo < datum(off)) {
+        best = abs(datum(tails + ch));
     }
-    if (hi >= data[off + k - 1u]) {
-        best = max(best, abs(data[tails + channels + ch]));
+    if (hi >= datum(off + k - 1u)) {
+        best = max(best, abs(datum(tails + channels + ch)));
     }
     for (var seg = 0u; seg + 1u < k; seg = seg + 1u) {
-        let a = data[off + seg];
-        let b = data[off + seg + 1u];
+        let a = datum(off + seg);
+        let b = datum(off + seg + 1u);
         if (!(b > a) || hi < a || lo > b) {
             continue;
         }
         let c = coeff + 4u * (seg * channels + ch);
-        let c0 = data[c];
-        let c1 = data[c + 1u];
-        let c2 = data[c + 2u];
+        let c0 = datum(c);
+        let c1 = datum(c + 1u);
+        let c2 = datum(c + 2u);
         let t0 = clamp((lo - a) / (b - a), 0.0, 1.0);
         let t1 = clamp((hi - a) / (b - a), 0.0, 1.0);
         best = max(best, max(abs((c2 * t0 + c1) * t0 + c0), abs((c2 * t1 + c1) * t1 + c0)));

@@ -22,13 +22,13 @@ fn height_moments(l_in: f32) -> HeightMoments {
     let l_min = exp(params.dh_ln_min);
     if (l < l_min) {
         let s = l / l_min;
-        return HeightMoments(s * data[off], 1.0 + s * (data[off + 1u] - 1.0));
+        return HeightMoments(s * datum(off), 1.0 + s * (datum(off + 1u) - 1.0));
     }
     let u = clamp((log(l) - params.dh_ln_min) / (params.dh_ln_max - params.dh_ln_min) * f32(n - 1u), 0.0, f32(n - 1u));
     let i = min(u32(floor(u)), n - 2u);
     let f = u - f32(i);
-    let a = vec2<f32>(data[off + 2u * i], data[off + 2u * i + 1u]);
-    let b = vec2<f32>(data[off + 2u * i + 2u], data[off + 2u * i + 3u]);
+    let a = vec2<f32>(datum(off + 2u * i), datum(off + 2u * i + 1u));
+    let b = vec2<f32>(datum(off + 2u * i + 2u), datum(off + 2u * i + 3u));
     let v = mix(a, b, f);
     return HeightMoments(v.x, v.y);
 }

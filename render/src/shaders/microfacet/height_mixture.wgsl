@@ -19,7 +19,7 @@ fn mixture_edges(mean: f32, sd: f32) -> u32 {
     var inside = 0u;
     if (sd > 0.0) {
         for (var i = 0u; i < k; i = i + 1u) {
-            let u = norm_cdf((data[off + i] - mean) * inv);
+            let u = norm_cdf((datum(off + i) - mean) * inv);
             if (u > KNOT_MARGIN && u < 1.0 - KNOT_MARGIN) {
                 inside = inside + 1u;
             }
@@ -30,7 +30,7 @@ fn mixture_edges(mean: f32, sd: f32) -> u32 {
     var seen = 0u;
     if (sd > 0.0) {
         for (var i = 0u; i < k; i = i + 1u) {
-            let u = norm_cdf((data[off + i] - mean) * inv);
+            let u = norm_cdf((datum(off + i) - mean) * inv);
             if (u > KNOT_MARGIN && u < 1.0 - KNOT_MARGIN) {
                 if (seen % stride == 0u && t < MAX_KNOT_EDGES) {
                     mixture_knot_buf[t] = u;

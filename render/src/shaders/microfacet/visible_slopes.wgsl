@@ -5,7 +5,7 @@
 // Node i of visible_slopes::slope_rule: (z.x, z.y, weight) of the standard bivariate normal.
 fn slope_node(i: u32) -> vec3<f32> {
     let b = params.slope_rule_offset + 3u * i;
-    return vec3<f32>(data[b], data[b + 1u], data[b + 2u]);
+    return vec3<f32>(datum(b), datum(b + 1u), datum(b + 2u));
 }
 
 //#endif

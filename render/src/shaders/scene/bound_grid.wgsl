@@ -44,8 +44,8 @@ fn grid_range(lo: vec2<f32>, hi: vec2<f32>) -> vec3<f32> {
         var i = i0;
         for (; i <= i1; i = i + 1u) {
             let c = base + 2u * (j * size + i);
-            a = min(a, data[c]);
-            b = max(b, data[c + 1u]);
+            a = min(a, datum(c));
+            b = max(b, datum(c + 1u));
         }
         note_cut(i <= i1);
     }

@@ -22,7 +22,7 @@ fn hermite_basis(s: f32) -> HermiteBasis {
 // Vertex k of the table: [f, c·f_x, c·f_y, c²·f_xy].
 fn field_vertex(k: u32) -> vec4<f32> {
     let o = params.field_offset + 4u * k;
-    return vec4<f32>(data[o], data[o + 1u], data[o + 2u], data[o + 3u]);
+    return vec4<f32>(datum(o), datum(o + 1u), datum(o + 2u), datum(o + 3u));
 }
 
 // One corner's share of (F, ∂F/∂s, ∂F/∂t): value basis (a, b) and slope basis (da, db) along s,
