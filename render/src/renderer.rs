@@ -200,11 +200,10 @@ pub fn data_limit(ctx: &GpuContext) -> u64 {
 }
 
 /// The material's data as an R32Uint texture of [`DATA_ROW`] words a row, the last row
-/// zero-padded. The caller has checked the size against [`data_limit`].
-fn data_texture(ctx: &GpuContext, data: &[f32]) -> wgpu::TextureView {
+/// zero-padded (in place). The caller has checked the size against [`data_limit`].
+fn data_texture(ctx: &GpuContext, mut words: Vec<f32>) -> wgpu::TextureView {
     let row = DATA_ROW as usize;
-    let rows = data.len().div_ceil(row).max(1);
-    let mut words = data.to_vec();
+    let rows = words.len().div_ceil(row).max(1);
     words.resize(rows * row, 0.0);
     let size = wgpu::Extent3d {
         width: DATA_ROW,
@@ -1110,7 +1109,8 @@ impl GpuMaterial {
                 hint: format!(" ({parts}); use smaller tables or a smaller image"),
             });
         }
-        let data_view = data_texture(ctx, &data);
+        let wave_words = wave_table(&data, &params);
+        let data_view = data_texture(ctx, data);
         let params_buffer = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("material params"),
             size: std::mem::size_of::<MaterialParams>() as u64,
@@ -1126,7 +1126,7 @@ impl GpuMaterial {
             mapped_at_creation: false,
         });
         ctx.queue
-            .write_buffer(&waves, 0, bytemuck::cast_slice(&wave_table(&data, &params)));
+            .write_buffer(&waves, 0, bytemuck::cast_slice(&wave_words));
         Ok(Self {
             data: data_view,
             params: params_buffer,
