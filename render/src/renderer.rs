@@ -166,7 +166,7 @@ struct Layout {
     transfer_poly: u32,
 }
 
-/// A material uploaded for the GPU: its data buffer and its parameters (both constant).
+/// A material uploaded for the GPU: its data texture, parameters and wave table (all constant).
 #[derive(Debug)]
 pub struct GpuMaterial {
     /// The data's f32 words as the bits of an R32Uint texture, [`DATA_ROW`] a row (binding 1;
