@@ -278,8 +278,9 @@ pub fn bundle(prepared: &Evaluator) -> Result<Vec<(String, Vec<u8>)>, ExportErro
                 "levels": t.image.levels.len(),
                 "tile_world_width": t.size,
                 "level_table_offset_floats": params.image_offset,
-                "layout": "at level_table_offset, per level 5 slots: value offset, grad offset, width, height \
-                           (u32 bits), mean variance (f32); the value grid holds (f̄, f²‾) per texel, the cell grid \
+                "layout": "at level_table_offset, per level 7 slots: value offset, grad offset, width, height \
+                           (u32 bits), mean variance, Lipschitz constants of f̄ along x and y per level-0 texel \
+                           (f32); the value grid holds (f̄, f²‾) per texel, the cell grid \
                            (f_x, f_y, f_x², f_y², f_x·f_y) per texel, half a texel after the value grid [HNPN14 Sec. 4.2]",
                 "coordinates": "texel = (image_u0, image_v0) + x·image_scale for x relative to the target the \
                                 bundle was made for (the origin); tiles wrap",

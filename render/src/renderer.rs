@@ -614,8 +614,12 @@ fn push_poly(data: &mut Vec<f32>, p: &PiecewisePoly, channels: &[usize]) -> u32 
 }
 
 /// The image pyramid: per level the value grid (f̄, f²‾) and the cell grid (f_x, f_y, f_x², f_y²,
-/// f_x·f_y), then a level table of 5 slots per level (value offset, grad offset, width, height as
-/// u32 bits; mean variance as f32). The target is folded into the texel origin in f64.
+/// f_x·f_y), then a level table of [`IMAGE_LEVEL_SLOTS`] slots per level (value offset, grad
+/// offset, width, height as u32 bits; mean variance, Lipschitz constants along x and y per level-0
+/// texel as f32). The target is folded into the texel origin in f64.
+/// Slots per level in the image's level table (WGSL `IMAGE_LEVEL_SLOTS`).
+pub const IMAGE_LEVEL_SLOTS: usize = 7;
+
 fn push_image(
     data: &mut Vec<f32>,
     base: &mut MaterialParams,
@@ -639,6 +643,8 @@ fn push_image(
             f32::from_bits(l.width as u32),
             f32::from_bits(l.height as u32),
             l.mean_variance as f32,
+            l.lipschitz.x as f32,
+            l.lipschitz.y as f32,
         ]);
     }
     let scale = tiled.texels_per_unit();

@@ -87,6 +87,8 @@ const MIRRORS: &[(&str, &str, &str, &str)] = &[
     ("driver/image.wgsl", "image_grad_cov", "driver/image.rs", "grad_cov"),
     ("driver/image.wgsl", "image_filtered_driver", "driver/field.rs", "filtered"),
     ("driver/image.wgsl", "image_lipschitz_along", "driver/field.rs", "lipschitz_along"),
+    ("driver/image.wgsl", "image_lod_lipschitz", "driver/image.rs", "lod_lipschitz"),
+    ("driver/image.wgsl", "image_lod_lipschitz_along", "driver/field.rs", "lod_lipschitz_along"),
     ("scene/direction.wgsl", "basis_t", "scene/direction.rs", "basis"),
     ("scene/direction.wgsl", "basis_b", "scene/direction.rs", "basis"),
     ("scene/surface.wgsl", "surface_height", "scene/surface.rs", "height"),

@@ -147,8 +147,9 @@ impl DriverField {
     }
 
     /// A Lipschitz constant of f̄ at footprint `fp` along `dir`: the noise's attenuated components;
-    /// for the image the level-0 constant (a box mip's neighbour differences are averages of
-    /// level-0 differences, and interpolation and probe averaging are convex combinations).
+    /// for the image the constants of the levels the footprint's probe plan blends
+    /// ([`ImageDriver::lod_lipschitz`]: coarse levels are smooth, so the far field marches in long
+    /// steps).
     pub fn lod_lipschitz_along(&self, dir: DVec2, fp: Footprint) -> f64 {
         match self {
             Self::Noise(n) => n
@@ -156,7 +157,11 @@ impl DriverField {
                 .iter()
                 .map(|w| w.amplitude.abs() * n.attenuation(w, fp) * TAU * w.k.dot(dir).abs())
                 .sum(),
-            Self::Image(_) => self.lipschitz_along(dir),
+            Self::Image(t) => {
+                let s = t.texels_per_unit();
+                let l = t.image.lod_lipschitz(&t.image.plan(fp.cov * (s * s)));
+                s * (l.x * dir.x.abs() + l.y * dir.y.abs())
+            }
         }
     }
 

@@ -18,6 +18,7 @@
 //! functions see the same N(0, 1) convention as the procedural driver; the original mean and std are
 //! kept. A constant image standardizes to 0 everywhere.
 
+use crate::math::rounding::f32_up;
 use glam::{DMat2, DVec2};
 
 /// One mip level.
@@ -34,6 +35,11 @@ pub struct MipLevel {
     /// Mean of `f²‾ − f̄²` over the level's texels: the footprint variance of f averaged over
     /// position (the image's analogue of the noise's phase-averaged σ_f²).
     pub mean_variance: f64,
+    /// Lipschitz constants of the level's bilinear interpolant of f̄ along x and y, per level-0
+    /// texel: its largest wrapped neighbour differences times the level's texel size (the
+    /// level-of-detail march's rate at this level, [`ImageDriver::lod_lipschitz`]). Coarser levels
+    /// are smoother: at level 0 it is [`ImageDriver::lipschitz`].
+    pub lipschitz: DVec2,
 }
 
 /// Errors building an image driver.
@@ -231,6 +237,7 @@ impl ImageDriver {
             value: base.iter().map(|v| [*v as f32, (v * v) as f32]).collect(),
             grad,
             mean_variance: 0.0,
+            lipschitz: DVec2::ZERO,
         }];
         while let Some(last) = levels.last().filter(|l| l.width > 1 || l.height > 1) {
             levels.push(downsample(last));
@@ -242,6 +249,7 @@ impl ImageDriver {
                 .map(|v| (f64::from(v[1]) - f64::from(v[0]).powi(2)).max(0.0))
                 .sum::<f64>()
                 / l.value.len() as f64;
+            l.lipschitz = level_lipschitz(l, (width, height));
         }
         Ok(Self {
             levels,
@@ -404,6 +412,17 @@ impl ImageDriver {
             + t * (self.levels[l1].mean_variance - self.levels[l0].mean_variance);
         v.max(0.0).sqrt()
     }
+
+    /// Lipschitz constants along x and y (per level-0 texel) of [`Self::footprint_mean`] under
+    /// `plan`: the two blended levels' [`MipLevel::lipschitz`] mixed with the blend weight (a
+    /// convex combination of two functions is Lipschitz with the combination of their constants;
+    /// averaging shifted probes keeps it). Never above [`Self::lipschitz`] by more than f32
+    /// rounding, and far below it at coarse levels: the far field's march takes long steps.
+    pub fn lod_lipschitz(&self, plan: &ProbePlan) -> DVec2 {
+        let (l0, l1, t) = self.split_lod(plan.lod);
+        let (a, b) = (self.levels[l0].lipschitz, self.levels[l1].lipschitz);
+        a * (1.0 - t) + b * t
+    }
 }
 
 /// The mip level whose trilinear lookup has a kernel of std `sigma` (level-0 texels), on average over
@@ -520,7 +539,30 @@ fn downsample(l: &MipLevel) -> MipLevel {
         value,
         grad,
         mean_variance: 0.0,
+        lipschitz: DVec2::ZERO,
     }
+}
+
+/// [`MipLevel::lipschitz`]: the largest wrapped neighbour differences of the level's f̄ along x
+/// and y (a bilinear interpolant's slope along an axis is a convex combination of them), scaled
+/// from the level's texels to level-0 texels (`image_driver::at_level`), rounded up to f32 so the
+/// GPU's copy is no tighter. A level one texel wide wraps onto itself: 0 along that axis.
+fn level_lipschitz(l: &MipLevel, base: (usize, usize)) -> DVec2 {
+    let (w, h) = (l.width, l.height);
+    let f = |x: usize, y: usize| f64::from(l.value[(y % h) * w + (x % w)][0]);
+    let mut lip = DVec2::ZERO;
+    for y in 0..h {
+        for x in 0..w {
+            let f00 = f(x, y);
+            lip = lip.max(DVec2::new(
+                (f(x + 1, y) - f00).abs(),
+                (f(x, y + 1) - f00).abs(),
+            ));
+        }
+    }
+    let scale = DVec2::new(w as f64 / base.0 as f64, h as f64 / base.1 as f64);
+    let v = lip * scale;
+    DVec2::new(f64::from(f32_up(v.x)), f64::from(f32_up(v.y)))
 }
 
 #[cfg(test)]
@@ -649,6 +691,51 @@ mod tests {
             .value_and_gradient(DVec2::new(3.2 + 16.0 * 3.0, 4.7 - 12.0 * 2.0))
             .0;
         assert!((a - b).abs() < 1e-9);
+    }
+
+    #[test]
+    fn footprint_means_are_lipschitz_with_their_levels_constants() {
+        // Non-power-of-two sides: levels 16×12, 8×6, 4×3, 2×2, 1×1.
+        let d = random_image(16, 12, 5);
+        assert_eq!(
+            d.levels[0].lipschitz,
+            d.lipschitz.map(|v| f64::from(f32_up(v)))
+        );
+        let coarse = d.levels[2].lipschitz;
+        assert!(coarse.x < 0.7 * d.lipschitz.x && coarse.y < 0.7 * d.lipschitz.y);
+        let last = d.levels.last().unwrap();
+        assert_eq!(last.lipschitz, DVec2::ZERO);
+        let mut rng = Rng(17);
+        let mut tight: f64 = 0.0;
+        for k in 0..3000 {
+            let s1 = 0.2 + 8.0 * rng.uniform();
+            let s2 = s1 * (0.1 + 0.9 * rng.uniform());
+            let rot = DMat2::from_angle(rng.uniform() * 7.0);
+            let cov = rot * DMat2::from_diagonal(DVec2::new(s1 * s1, s2 * s2)) * rot.transpose();
+            let mut plan = d.plan(cov);
+            if k % 3 == 0 {
+                // Integer levels with one probe: at texel-centre rows the bound is attained.
+                plan = ProbePlan {
+                    lod: f64::from(k % 5),
+                    probes: 1,
+                    step: DVec2::ZERO,
+                };
+            }
+            let lip = d.lod_lipschitz(&plan);
+            let p = DVec2::new(rng.uniform() * 40.0 - 20.0, rng.uniform() * 40.0 - 20.0);
+            let dir = DVec2::from_angle(rng.uniform() * 7.0);
+            let e = 1e-5;
+            let slope = (d.footprint_mean(p + dir * e, &plan) - d.footprint_mean(p, &plan)) / e;
+            let bound = lip.x * dir.x.abs() + lip.y * dir.y.abs();
+            assert!(
+                slope.abs() <= bound * (1.0 + 1e-6) + 1e-6,
+                "{slope} > {bound}"
+            );
+            if bound > 0.0 {
+                tight = tight.max(slope.abs() / bound);
+            }
+        }
+        assert!(tight > 0.95, "the bound is attained somewhere: {tight}");
     }
 
     #[test]

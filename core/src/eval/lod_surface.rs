@@ -90,3 +90,68 @@ impl Evaluator {
         )
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::driver::image::ImageDriver;
+    use crate::driver::test_images;
+    use crate::eval::test_materials::gaussian_material;
+    use crate::material::Driver;
+    use crate::math::random::splitmix;
+    use std::sync::Arc;
+
+    /// The image's level-of-detail march, whose rate now comes from the levels the footprint
+    /// blends (coarse levels march in long steps), never steps over a crossing of h̄: along
+    /// grazing and steep rays, from a point footprint to one of 64 texels, a dense scan of
+    /// `[0, t)` finds the gap non-negative, and at `t` the ray is on h̄.
+    #[test]
+    fn the_image_level_of_detail_march_never_steps_over_a_crossing() {
+        let side = test_images::SIDE;
+        let image = Arc::new(ImageDriver::new(side, side, &test_images::bricks()).unwrap());
+        let mut m = gaussian_material();
+        m.driver = Driver::Image {
+            path: "bricks.png".into(),
+            size: 1.0,
+        };
+        m.heights.sigma_h = 0.01;
+        let e = Evaluator::with_image(&m, Some(image), None).unwrap();
+        let texel = 1.0 / side as f64;
+        let mut rng = 5u64;
+        let mut hits = 0;
+        for i in 0..84 {
+            let sigma = texel * [0.0, 0.3, 1.0, 2.5, 6.0, 16.0, 64.0][i % 7];
+            let fp = Footprint::isotropic(sigma);
+            let theta = (55.0 + 34.0 * splitmix(&mut rng)).to_radians();
+            let phi = std::f64::consts::TAU * splitmix(&mut rng);
+            let d = -DVec3::new(
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            );
+            let o = DVec3::new(
+                splitmix(&mut rng),
+                splitmix(&mut rng),
+                e.surface.h_max * 1.001 + 1e-6,
+            );
+            let Some(t) = e.lod_march(o, d, fp) else {
+                continue;
+            };
+            hits += 1;
+            let gap = |t: f64| {
+                let q = o + d * t;
+                q.z - e.lod_height(DVec2::new(q.x, q.y), fp)
+            };
+            let n = 3000;
+            for j in 0..n {
+                let s = t * j as f64 / n as f64;
+                assert!(
+                    gap(s) > -1e-9,
+                    "σ {sigma}: crossing at {s} skipped (hit at {t})"
+                );
+            }
+            assert!(gap(t).abs() < 1e-7, "σ {sigma}: off h̄ by {}", gap(t));
+        }
+        assert!(hits > 70, "downward rays meet h̄: {hits}");
+    }
+}

@@ -2,11 +2,12 @@
 // units) and of the image half of driver_field.rs, function for function under the same names
 // (prefixed `image_` where WGSL needs it). Uses `params` and `data` from material.wgsl.
 //
-// Data layout (render::material_data): at params.image_offset, per level 5 slots
-// [value offset, grad offset, width, height (u32 bits), mean_variance (f32)]; the value grid holds
-// (f̄, f²‾) per texel, the cell grid (f_x, f_y, f_x², f_y², f_x·f_y) per texel.
+// Data layout (render::material_data): at params.image_offset, per level IMAGE_LEVEL_SLOTS slots
+// [value offset, grad offset, width, height (u32 bits), mean_variance, Lipschitz x, y (f32)]; the
+// value grid holds (f̄, f²‾) per texel, the cell grid (f_x, f_y, f_x², f_y², f_x·f_y) per texel.
 
 const IMAGE_MAX_PROBES: u32 = 8u;
+const IMAGE_LEVEL_SLOTS: u32 = 7u;
 
 struct ImageLevel {
     value_offset: u32,
@@ -14,16 +15,18 @@ struct ImageLevel {
     width: u32,
     height: u32,
     mean_variance: f32,
+    lipschitz: vec2<f32>,
 }
 
 fn image_level(l: u32) -> ImageLevel {
-    let b = params.image_offset + 5u * min(l, params.image_levels - 1u);
+    let b = params.image_offset + IMAGE_LEVEL_SLOTS * min(l, params.image_levels - 1u);
     var r: ImageLevel;
     r.value_offset = bitcast<u32>(datum(b));
     r.grad_offset = bitcast<u32>(datum(b + 1u));
     r.width = max(bitcast<u32>(datum(b + 2u)), 1u);
     r.height = max(bitcast<u32>(datum(b + 3u)), 1u);
     r.mean_variance = datum(b + 4u);
+    r.lipschitz = vec2<f32>(datum(b + 5u), datum(b + 6u));
     return r;
 }
 
@@ -244,6 +247,13 @@ fn image_mean_std(lod_in: f32) -> f32 {
     return sqrt(max(mix(image_level(l0).mean_variance, image_level(l1).mean_variance, t), 0.0));
 }
 
+// ImageDriver::lod_lipschitz: Lipschitz constants along x and y (per level-0 texel) of
+// image_footprint_mean under a plan.
+fn image_lod_lipschitz(plan: ProbePlan) -> vec2<f32> {
+    let sp = image_split_lod(plan.lod);
+    return mix(image_level(sp.l0).lipschitz, image_level(sp.l1).lipschitz, sp.t);
+}
+
 // ---------------------------------------------------------------- driver_field.rs (image half)
 // World position relative to the camera target → level-0 texel coordinate (the CPU folds the
 // target into image_u0/v0 in f64).
@@ -272,7 +282,13 @@ fn image_filtered_driver(x: vec2<f32>, fp: vec3<f32>) -> FilteredDriver {
     return r;
 }
 
-// DriverField::lipschitz_along for the image (also its lod_lipschitz_along).
+// DriverField::lipschitz_along for the image.
 fn image_lipschitz_along(dir: vec2<f32>) -> f32 {
     return params.image_scale * (params.image_lip_x * abs(dir.x) + params.image_lip_y * abs(dir.y));
+}
+
+// DriverField::lod_lipschitz_along for the image (needs lod_prepare's plan).
+fn image_lod_lipschitz_along(dir: vec2<f32>, plan: ProbePlan) -> f32 {
+    let l = image_lod_lipschitz(plan);
+    return params.image_scale * (l.x * abs(dir.x) + l.y * abs(dir.y));
 }
