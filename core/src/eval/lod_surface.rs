@@ -24,15 +24,19 @@ impl Evaluator {
 
     /// Rate bound of the gap along d: `|d_z| + K|d_xy|`, with K = σ_h·max|g′|·L̄(d̂) and L̄ the
     /// Lipschitz constant of f̄ ([`DriverField::lod_lipschitz_along`]: for the noise the attenuated
-    /// components `Σ|a_i| g_i 2π|k_i·d̂|`; ∂ḡ/∂m = E[g′] ≤ max|g′|).
+    /// components `Σ|a_i| g_i 2π|k_i·d̂|`; for the image its levels' constants, or under
+    /// [`March::Reference`] the explicit surface's, as before #15; ∂ḡ/∂m = E[g′] ≤ max|g′|).
     fn lod_rate(&self, d: DVec3, fp: Footprint) -> f64 {
         let dxy = DVec2::new(d.x, d.y);
         let r = dxy.length();
         let mut k = 0.0;
         if r > 0.0 {
-            k = self.surface.driver.lod_lipschitz_along(dxy / r, fp)
-                * self.surface.sigma_h
-                * self.surface.g_lip;
+            let driver = &self.surface.driver;
+            let lip = match (driver, self.surface.march) {
+                (DriverField::Image(_), March::Reference) => driver.lipschitz_along(dxy / r),
+                _ => driver.lod_lipschitz_along(dxy / r, fp),
+            };
+            k = lip * self.surface.sigma_h * self.surface.g_lip;
         }
         d.z.abs() + k * r
     }
@@ -116,6 +120,9 @@ mod tests {
         };
         m.heights.sigma_h = 0.01;
         let e = Evaluator::with_image(&m, Some(image), None).unwrap();
+        assert_eq!(e.surface.march, March::Fast);
+        let mut reference = e.clone();
+        reference.surface.march = March::Reference;
         let texel = 1.0 / side as f64;
         let mut rng = 5u64;
         let mut hits = 0;
@@ -151,6 +158,14 @@ mod tests {
                 );
             }
             assert!(gap(t).abs() < 1e-7, "σ {sigma}: off h̄ by {}", gap(t));
+            // The reference march (the explicit surface's global constant) meets the same crossing.
+            let b = reference
+                .lod_march(o, d, fp)
+                .expect("the reference meets h̄ too");
+            assert!(
+                (t - b).abs() <= 1e-6 * t.max(1.0),
+                "σ {sigma}: {t} against {b}"
+            );
         }
         assert!(hits > 70, "downward rays meet h̄: {hits}");
     }

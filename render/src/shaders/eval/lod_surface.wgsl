@@ -115,7 +115,11 @@ fn lod_rate(d: vec3<f32>) -> f32 {
         let dir = d.xy / r;
 //#if image
         if (params.driver_kind == DRIVER_IMAGE) {
-            k = image_lod_lipschitz_along(dir, lod_plan);
+            if (params.march == MARCH_REFERENCE) {
+                k = image_lipschitz_along(dir);
+            } else {
+                k = image_lod_lipschitz_along(dir, lod_plan);
+            }
         }
 //#endif
 //#if noise
