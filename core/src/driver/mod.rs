@@ -7,6 +7,7 @@ pub mod field;
 pub mod footprint;
 pub mod histogram;
 pub mod image;
+pub mod mip_level;
 pub mod noise;
 #[cfg(test)]
 pub mod test_images;
