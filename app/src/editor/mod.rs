@@ -401,7 +401,7 @@ impl eframe::App for EditorApp {
                     .map_or(0.0, |s| s.frame.scale);
                 log::warn!(
                     "fps {:.1} (truth {truth}/{} spp, analytic scale {scale})",
-                    self.fps(),
+                    self.fps().unwrap_or(0.0),
                     self.view.truth_spp
                 );
                 self.fps_log = Some(now);

@@ -71,8 +71,14 @@ impl EditorApp {
             }
             ui.separator();
             if !self.deterministic {
-                let fps = self.fps();
-                ui.weak(format!("UI {fps:.0} fps"));
+                let text = match self.fps() {
+                    Some(fps) => format!("UI {fps:.0} fps"),
+                    None => "UI idle".to_string(),
+                };
+                ui.weak(text).on_hover_text(
+                    "The window's repaint rate while it repaints back to back (dragging, zoom \
+                     sweep); idle between changes, when nothing asks for a frame",
+                );
             }
             let now = ui.input(|i| i.time);
             if let Some(n) = self
@@ -90,17 +96,9 @@ impl EditorApp {
         });
     }
 
-    pub(super) fn fps(&self) -> f64 {
-        if self.frame_times.len() < 2 {
-            return 0.0;
-        }
-        let span =
-            self.frame_times.back().unwrap_or(&0.0) - self.frame_times.front().unwrap_or(&0.0);
-        if span > 0.0 {
-            (self.frame_times.len() - 1) as f64 / span
-        } else {
-            0.0
-        }
+    /// The window's repaint rate ([`repaint_rate`] over the last frames' times).
+    pub(super) fn fps(&self) -> Option<f64> {
+        repaint_rate(&self.frame_times)
     }
 }
 
@@ -111,5 +109,47 @@ fn short(m: ViewMode) -> &'static str {
         ViewMode::ViewIndependent => "view-indep.",
         ViewMode::Filtered => "filtered",
         ViewMode::Truth => "truth",
+    }
+}
+
+/// Most seconds between two frames of one run of back-to-back repaints.
+const BUSY_GAP: f64 = 0.5;
+
+/// Frames per second over the newest run of frames painted back to back (gaps up to
+/// [`BUSY_GAP`]), or `None` when the window is idle: egui repaints only on input or a new image, so
+/// a rate taken across idle gaps would read as a frozen window ("UI 0 fps") when nothing asked
+/// for a frame. Needs three frames in the run.
+fn repaint_rate(times: &std::collections::VecDeque<f64>) -> Option<f64> {
+    let newest = *times.back()?;
+    let mut oldest = newest;
+    let mut frames = 1usize;
+    for &t in times.iter().rev().skip(1) {
+        if !(oldest - t <= BUSY_GAP) {
+            break;
+        }
+        oldest = t;
+        frames += 1;
+    }
+    let span = newest - oldest;
+    (frames >= 3 && span > 0.0).then(|| (frames - 1) as f64 / span)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::VecDeque;
+
+    #[test]
+    fn the_repaint_rate_counts_only_the_newest_busy_run() {
+        // 20 frames a second for a second, then idle for 3 s and one frame: idle.
+        let mut t: VecDeque<f64> = (0..=20).map(|i| f64::from(i) * 0.05).collect();
+        assert!((repaint_rate(&t).unwrap() - 20.0).abs() < 1e-9);
+        t.push_back(4.0);
+        assert_eq!(repaint_rate(&t), None);
+        // Two more frames at 8 fps start a new run: its own rate, not the earlier one.
+        t.extend([4.125, 4.25]);
+        assert!((repaint_rate(&t).unwrap() - 8.0).abs() < 1e-9);
+        assert_eq!(repaint_rate(&VecDeque::new()), None);
+        assert_eq!(repaint_rate(&VecDeque::from([1.0, f64::NAN, 2.0])), None);
     }
 }
