@@ -12,7 +12,10 @@
 use crate::driver::field::DriverField;
 use crate::eval::{Evaluator, FootprintQuery};
 use crate::material::transfer::TransferFunction;
-use crate::microfacet::effective_height::height_moments;
+use crate::eval::slope_weights::joint_inputs;
+use crate::material::color_terms::Affine;
+use crate::microfacet::effective_height::{HeightMoments, height_moments};
+use crate::microfacet::slope_masking::SLOPE_NODES;
 use crate::microfacet::masking_shadowing::G2;
 use crate::microfacet::slope_density::{NoiseSlopes, sinusoid_density_ratio};
 use crate::microfacet::slopes::{normal_of, slope_of};
@@ -65,18 +68,14 @@ impl Evaluator {
         let (m, s) = self.color.input_distribution(&loc, self.global_height);
         let terms = &self.material.terms;
         // The colour model over the visible and lit heights (L = Λo + Λi) for the directional
-        // light, over the visible heights (L = Λo) for the unshadowed environment.
-        let filtered_color = |l: f64| {
-            let hm = height_moments(l, f.height_filter);
+        // light, over the visible heights (L = Λo) for the unshadowed environment; at heights of
+        // moments (mean, std) within D_h(L) of moments `hm`.
+        let color_of = |l: f64, hm: HeightMoments, (mean, std): (f64, f64)| {
             self.color
-                .of_distribution(m + s * hm.mean, s * hm.std, l, (hm.mean, hm.std), s * s)
+                .of_distribution(m + s * mean, s * std, l, (hm.mean, hm.std), s * s)
         };
-        let sun_color = terms.affine(filtered_color(ms.total));
-        let env_color = if self.environment.is_some() {
-            terms.affine(filtered_color(ms.lambda_o))
-        } else {
-            sun_color
-        };
+        let hm_sun = height_moments(ms.total, f.height_filter);
+        let hm_env = height_moments(ms.lambda_o, f.height_filter);
         let vbar = if wi.z > 0.0 && cfg.wi.z > 0.0 {
             ms.mean_shadowing()
         } else {
@@ -84,23 +83,54 @@ impl Evaluator {
         };
         // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
         let mean = loc.stats.slope_mean;
-        let weights = self.slope_weights(cfg.footprint, mean, &sigma, cfg.wo);
-        // Slope-conditioned masking (#17) reweights the visible slopes and the sun's lobe.
-        let shading = self.visible_shading(mean, &sigma, cfg.wo, cfg.wi, frame, weights.as_ref());
         let lit = sun_visible * vbar;
         let mut spec = self.specular_lobes(mean, &sigma, cfg.wo, cfg.wi);
-        if let Some(w) = &weights {
-            let points = self.material.filtering.slope_points as usize;
-            let k = w.lobe_factor(
-                mean,
-                &sigma,
-                cfg.wo,
-                cfg.wi,
-                self.material.brdf.roughness,
-                points,
-            );
-            spec = spec.map(|v| v * k);
-        }
+        let points = f.slope_points as usize;
+        let (sun_color, env_color, shading) =
+            match self.slope_weights(cfg.footprint, mean, &sigma, cfg.wo) {
+                None => {
+                    let sun = terms.affine(color_of(ms.total, hm_sun, (hm_sun.mean, hm_sun.std)));
+                    let env = if self.environment.is_some() {
+                        terms.affine(color_of(ms.lambda_o, hm_env, (hm_env.mean, hm_env.std)))
+                    } else {
+                        sun
+                    };
+                    let shading = self.visible_shading(mean, &sigma, cfg.wo, cfg.wi, frame);
+                    (sun, env, shading)
+                }
+                Some(w) => {
+                    // Masking conditioned on height and slope jointly (#17): each slope node sees
+                    // its own heights, so colour and shading are summed together.
+                    let per_node = |l: f64, hm: HeightMoments| {
+                        let heights = w.heights(hm);
+                        let colors: [Affine; SLOPE_NODES] = std::array::from_fn(|j| {
+                            terms.affine(color_of(l, hm, (heights[j].mean, heights[j].std)))
+                        });
+                        (heights.map(|h| h.mass), colors)
+                    };
+                    let sun = per_node(ms.total, hm_sun);
+                    let env = if self.environment.is_some() {
+                        per_node(ms.lambda_o, hm_env)
+                    } else {
+                        sun
+                    };
+                    let buckets = self.visible_shading_buckets(
+                        mean, &sigma, cfg.wo, cfg.wi, frame, points, &w,
+                    );
+                    let joint = joint_inputs(&buckets, (&sun.0, &sun.1), (&env.0, &env.1));
+                    let k = w.lobe_factor(
+                        &sun.0,
+                        mean,
+                        &sigma,
+                        cfg.wo,
+                        cfg.wi,
+                        self.material.brdf.roughness,
+                        points,
+                    );
+                    spec = spec.map(|v| v * k);
+                    (joint.sun, joint.env, joint.shading)
+                }
+            };
         // The density ratio scales only the sun's specular term: where the sun does not reach the
         // pixel (shadowed, behind the mean plane, or no sun) or the lobe is 0, it changes nothing,
         // and its saddle point is the costliest part of the pixel (issue #15).

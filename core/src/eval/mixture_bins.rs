@@ -154,7 +154,7 @@ impl Evaluator {
             above_o += bin_exponent(lo, hi, ms.lambda_o);
             above += bin_exponent(lo, hi, ms.total);
             let (s, s_o): (SlopeShading, f64) =
-                self.visible_shading_sums(mean, &cov, cfg.wo, cfg.wi, frame, points, None);
+                self.visible_shading_sums(mean, &cov, cfg.wo, cfg.wi, frame, points);
             den += w1 * s_o;
             let (v, spec) = if sun_lit {
                 let lobe = self.specular_lobes(mean, &cov, cfg.wo, cfg.wi);

@@ -9,6 +9,7 @@ use crate::material::measured::ChannelWeights;
 use crate::material::merl_fit::fresnel_factor;
 use crate::math::gaussian::cholesky;
 use crate::microfacet::brdf::{BaseBrdf, filtered_specular, half_vector_posterior};
+use crate::microfacet::slope_masking::{SLOPE_NODES, slope_node};
 use crate::microfacet::slopes::SlopeCov;
 use crate::microfacet::slopes::{normal_of, slope_of};
 use crate::microfacet::visible_slopes::visible_slope_nodes;
@@ -31,6 +32,16 @@ pub struct SlopeShading {
 }
 
 impl SlopeShading {
+    /// Add `p` weighted by `w`.
+    pub fn add(&mut self, p: &SlopeShading, w: f64) {
+        self.cos += w * p.cos;
+        for c in 0..3 {
+            self.cs_cos[c] += w * p.cs_cos[c];
+            self.env[c] += w * p.env[c];
+            self.cs_env[c] += w * p.cs_env[c];
+        }
+    }
+
     /// Every input times `k`.
     #[must_use]
     pub fn scaled(self, k: f64) -> Self {
@@ -82,10 +93,9 @@ impl Evaluator {
         wo: DVec3,
         wi: DVec3,
         frame: &DMat3,
-        weights: Option<&SlopeWeights>,
     ) -> SlopeShading {
         let points = self.material.filtering.slope_points as usize;
-        let (acc, den) = self.visible_shading_sums(mean, sigma, wo, wi, frame, points, weights);
+        let (acc, den) = self.visible_shading_sums(mean, sigma, wo, wi, frame, points);
         if den > 0.0 {
             acc.scaled(1.0 / den)
         } else {
@@ -95,10 +105,6 @@ impl Evaluator {
 
     /// The sums [`Evaluator::visible_shading`] divides: each input weighted by the node's
     /// visible projected area, and the sum of those weights, on the rule of order `points`.
-    /// With slope-conditioned masking ([`SlopeWeights`]) each node's weight is also multiplied by
-    /// its masking factor (the mean visibility stays the views', only its share among the slopes
-    /// moves).
-    #[allow(clippy::too_many_arguments)]
     pub(super) fn visible_shading_sums(
         &self,
         mean: DVec2,
@@ -107,22 +113,47 @@ impl Evaluator {
         wi: DVec3,
         frame: &DMat3,
         points: usize,
-        weights: Option<&SlopeWeights>,
     ) -> (SlopeShading, f64) {
         let mut acc = SlopeShading::default();
         let mut den = 0.0;
         visible_slope_nodes(mean, sigma, wo, points, |n, w| {
-            let w = w * weights.map_or(1.0, |c| c.at(slope_of(n)));
             den += w;
-            let p = self.point_shading(n, wi, frame);
-            acc.cos += w * p.cos;
-            for c in 0..3 {
-                acc.cs_cos[c] += w * p.cs_cos[c];
-                acc.env[c] += w * p.env[c];
-                acc.cs_env[c] += w * p.cs_env[c];
-            }
+            acc.add(&self.point_shading(n, wi, frame), w);
         });
         (acc, den)
+    }
+
+    /// [`Evaluator::visible_shading_sums`] split over the slope nodes of `weights` (slope along
+    /// the view in the unresolved deviations, [`SlopeWeights::coordinate`]): each visible node
+    /// goes to the two slope nodes around it with linear (hat) weights, so that a quantity linear
+    /// between the slope nodes, summed per node against these, is its exact sum over the visible
+    /// nodes ([`crate::eval::slope_weights::joint_inputs`]). Unnormalised, with each bucket's
+    /// weight.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn visible_shading_buckets(
+        &self,
+        mean: DVec2,
+        sigma: &SlopeCov,
+        wo: DVec3,
+        wi: DVec3,
+        frame: &DMat3,
+        points: usize,
+        weights: &SlopeWeights,
+    ) -> [(SlopeShading, f64); SLOPE_NODES] {
+        let mut out = [(SlopeShading::default(), 0.0); SLOPE_NODES];
+        visible_slope_nodes(mean, sigma, wo, points, |n, w| {
+            let z = weights.coordinate(slope_of(n));
+            let x = (if z.is_nan() { 0.0 } else { z } - slope_node(0))
+                .clamp(0.0, (SLOPE_NODES - 1) as f64);
+            let j = (x as usize).min(SLOPE_NODES - 2);
+            let f = x - j as f64;
+            let p = self.point_shading(n, wi, frame);
+            for (k, wk) in [(j, w * (1.0 - f)), (j + 1, w * f)] {
+                out[k].0.add(&p, wk);
+                out[k].1 += wk;
+            }
+        });
+        out
     }
 
     /// Radiance from the combined colour `A + K ⊙ C_s` (`sun_color` under the directional light,

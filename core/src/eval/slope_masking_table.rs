@@ -16,7 +16,7 @@
 
 use crate::driver::noise::SumOfSines;
 use crate::microfacet::slope_masking::{
-    ConditionedMasking, LineProcess, ProcessGrid, SLOPE_NODES, conditioned_masking_on,
+    HEIGHT_NODES, JointMasking, LineProcess, ProcessGrid, SLOPE_NODES, joint_masking_on,
 };
 use glam::DVec2;
 use rayon::prelude::*;
@@ -33,8 +33,8 @@ pub const TABLE_NUS: usize = 12;
 pub const NU_MIN: f64 = 0.08;
 /// The ratio of successive ν nodes.
 pub const NU_RATIO: f64 = 1.5;
-/// f32 values per entry: the slope profile.
-pub const ENTRY: usize = SLOPE_NODES;
+/// f32 values per entry: `ln r` of [`JointMasking`] at every (height, slope) node, height-major.
+pub const ENTRY: usize = HEIGHT_NODES * SLOPE_NODES;
 
 /// The table (module docs).
 #[derive(Clone, Debug, PartialEq)]
@@ -113,10 +113,10 @@ impl SlopeMaskingTable {
                 let mut out = Vec::with_capacity(TABLE_NUS * ENTRY);
                 for j in 0..TABLE_NUS {
                     let c = match &grid {
-                        Some(g) => conditioned_masking_on(g, nu_node(j)),
-                        None => ConditionedMasking::none(),
+                        Some(g) => joint_masking_on(g, nu_node(j)),
+                        None => JointMasking::none(),
                     };
-                    out.extend(c.slopes.iter().map(|v| *v as f32));
+                    out.extend(c.log_ratio.iter().flatten().map(|v| *v as f32));
                 }
                 out
             })
@@ -128,10 +128,10 @@ impl SlopeMaskingTable {
         })
     }
 
-    /// The profiles for a ray of horizontal direction `dir` (unit), a footprint of standard
-    /// deviation `r` along it and slope `nu`: multilinear between the nodes (module docs).
-    /// Non-finite inputs are clamped to the first nodes.
-    pub fn lookup(&self, dir: DVec2, r: f64, nu: f64) -> ConditionedMasking {
+    /// The masking for a ray of horizontal direction `dir` (unit), a footprint of standard
+    /// deviation `r` along it and slope `nu`: `ln r` multilinear between the nodes (module
+    /// docs). Non-finite inputs are clamped to the first nodes.
+    pub fn lookup(&self, dir: DVec2, r: f64, nu: f64) -> JointMasking {
         let (a0, a1, fa) = azimuth_coordinate(dir);
         let lv = if r > 0.0 && r.is_finite() {
             ((self.r0 / r).ln() / self.level_step).clamp(0.0, (TABLE_LEVELS - 1) as f64)
@@ -164,7 +164,11 @@ impl SlopeMaskingTable {
                 }
             }
         }
-        ConditionedMasking { slopes: acc }
+        let mut out = JointMasking::none();
+        for (i, row) in out.log_ratio.iter_mut().enumerate() {
+            row.copy_from_slice(&acc[i * SLOPE_NODES..(i + 1) * SLOPE_NODES]);
+        }
+        out
     }
 }
 
@@ -196,10 +200,10 @@ fn split(x: f64, n: usize) -> (usize, f64) {
 mod tests {
     use super::*;
     use crate::eval::test_materials::preset;
-    use crate::microfacet::slope_masking::conditioned_masking;
+    use crate::microfacet::slope_masking::{MAX_LOG_RATIO, height_node, slope_node};
 
     #[test]
-    fn the_lookup_between_nodes_follows_the_direct_profile() {
+    fn the_lookup_between_nodes_follows_the_direct_masking() {
         let m = preset("snake-skin");
         let noise = m.noise().expect("noise");
         let t0 = std::time::Instant::now();
@@ -217,29 +221,30 @@ mod tests {
                 )
             }))
             .expect("process");
-            let direct = conditioned_masking(&process, nu);
+            let direct = joint_masking_on(&ProcessGrid::new(&process, nu), nu);
             let looked = table.lookup(dir, r, nu);
-            // Compare on the front slopes, relative to the profile's mean there (only the shape
-            // is used).
-            let front: Vec<usize> = (0..SLOPE_NODES)
-                .filter(|j| crate::microfacet::slope_masking::slope_node(*j) < nu - 0.5)
-                .collect();
-            let mean = |p: &[f64; SLOPE_NODES]| {
-                front.iter().map(|j| p[*j]).sum::<f64>() / front.len() as f64
-            };
-            let (md, ml) = (mean(&direct.slopes), mean(&looked.slopes));
-            for j in &front {
-                let (d, l) = (direct.slopes[*j] / md, looked.slopes[*j] / ml);
-                assert!(
-                    (d - l).abs() < 0.06,
-                    "φ {phi}, level {level}, ν {nu}, z {}: direct {d:.3}, table {l:.3}",
-                    crate::microfacet::slope_masking::slope_node(*j)
-                );
+            // Where D_h lives (heights above −1.5σ for any ν the table holds) and on the front
+            // slopes, the ratio r within 6% (ln r within 0.06).
+            for i in 3..HEIGHT_NODES {
+                for j in (0..SLOPE_NODES).filter(|j| slope_node(*j) < nu - 0.5) {
+                    let (d, l) = (direct.log_ratio[i][j], looked.log_ratio[i][j]);
+                    assert!(
+                        (d - l).abs() < 0.06,
+                        "φ {phi}, level {level}, ν {nu}, h {}, z {}: direct {d:.3}, table {l:.3}",
+                        height_node(i),
+                        slope_node(j)
+                    );
+                }
             }
         }
-        // Every entry is finite and in range.
-        assert!(table.data.iter().all(|v| v.is_finite() && *v >= 0.0));
+        // Every entry is finite and within the bound.
+        assert!(
+            table
+                .data
+                .iter()
+                .all(|v| v.is_finite() && v.abs() <= MAX_LOG_RATIO as f32)
+        );
         let c = table.lookup(DVec2::new(f64::NAN, 1.0), f64::NAN, f64::NAN);
-        assert!(c.slopes.iter().all(|v| v.is_finite()));
+        assert!(c.log_ratio.iter().flatten().all(|v| v.is_finite()));
     }
 }

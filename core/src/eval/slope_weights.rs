@@ -11,15 +11,28 @@
 
 use crate::driver::footprint::Footprint;
 use crate::eval::Evaluator;
+use crate::eval::shading::SlopeShading;
+use crate::material::color_terms::Affine;
 use crate::microfacet::brdf::half_vector_posterior;
-use crate::microfacet::slope_masking::{SLOPE_NODES, SlopeMasking, profile_at};
+use crate::microfacet::effective_height::HeightMoments;
+use crate::microfacet::slope_masking::{JointMasking, SLOPE_NODES, SlopeMasking, profile_at};
 use crate::microfacet::slopes::{SlopeCov, slope_of};
 use crate::microfacet::visible_slopes::visible_slope_nodes;
 use glam::{DVec2, DVec3};
 
-/// The masking factor of the visible slopes: the profile of
-/// [`crate::microfacet::slope_masking::conditioned_masking`] over the slope along the view's
-/// azimuth `dir` relative to the footprint's mean, in its standard deviations.
+/// Probabilists' Gauss–Hermite rule of 5 points, `E[f(Z)]` for `Z ~ N(0, 1)`: exact for
+/// polynomials to degree 9. `r(h, z)` is smooth in h on D_h's scale, so 5 points carry it.
+const HERMITE5: [(f64, f64); 5] = [
+    (-2.856_970_013_872_806, 0.011_257_411_327_720_69),
+    (-1.355_626_179_974_266, 0.222_075_922_005_612_6),
+    (0.0, 0.533_333_333_333_333_3),
+    (1.355_626_179_974_266, 0.222_075_922_005_612_6),
+    (2.856_970_013_872_806, 0.011_257_411_327_720_69),
+];
+
+/// The masking of the visible (height, slope) pairs, for a footprint seen from one direction: the
+/// slope along the view's azimuth `dir` relative to the footprint's mean, in its standard
+/// deviations, indexes [`JointMasking`]'s slope nodes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SlopeWeights {
     /// Unit horizontal direction toward the eye.
@@ -28,24 +41,72 @@ pub struct SlopeWeights {
     pub mean: f64,
     /// The unresolved slopes' standard deviation along `dir`.
     pub sd: f64,
-    /// `E_h₀[G1(h₀, z)]` at [`crate::microfacet::slope_masking::slope_node`].
-    pub profile: [f64; SLOPE_NODES],
+    /// `ln r(h, z)`, the slope-conditioned masking over Smith's.
+    pub joint: JointMasking,
+}
+
+/// The heights seen at one slope node: `D_h(h)·r(h, z_j)` with D_h the views' effective height
+/// distribution (Gaussian of D_h's exact moments, [HNPN14 Eqs. 14–17]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SlopeHeights {
+    /// `E_{D_h}[r(h, z_j)]`: the node's share of the visibility relative to Smith's.
+    pub mass: f64,
+    /// Mean height (σ_h units) of `D_h·r`.
+    pub mean: f64,
+    /// Its standard deviation.
+    pub std: f64,
 }
 
 impl SlopeWeights {
-    /// The factor of a facet of slope `s` (world slope space).
-    pub fn at(&self, s: DVec2) -> f64 {
-        profile_at(&self.profile, (s.dot(self.dir) - self.mean) / self.sd)
+    /// The slope of facet `s` (world slope space) along the view, in the unresolved deviations.
+    pub fn coordinate(&self, s: DVec2) -> f64 {
+        (s.dot(self.dir) - self.mean) / self.sd
+    }
+
+    /// The factor of a facet of slope `s` under a profile over the slope nodes (linear between
+    /// them, clamped at the ends, [`profile_at`]).
+    pub fn at(&self, profile: &[f64; SLOPE_NODES], s: DVec2) -> f64 {
+        profile_at(profile, self.coordinate(s))
+    }
+
+    /// The heights seen at each slope node, for visible heights `D_h` of standardized moments
+    /// `hm` (5-point Gauss–Hermite on its Gaussian). Where the masking is Smith's (`r ≡ 1`) every
+    /// node is `(1, hm.mean, hm.std)`: the views' D_h.
+    pub fn heights(&self, hm: HeightMoments) -> [SlopeHeights; SLOPE_NODES] {
+        std::array::from_fn(|j| {
+            let (mut m0, mut m1, mut m2) = (0.0, 0.0, 0.0);
+            for (x, w) in HERMITE5 {
+                let h = hm.mean + hm.std * x;
+                let r = w * self.joint.log_ratio_at(h, j).exp();
+                m0 += r;
+                m1 += r * x;
+                m2 += r * x * x;
+            }
+            if !(m0 > 0.0 && m0.is_finite()) {
+                return SlopeHeights {
+                    mass: 0.0,
+                    mean: hm.mean,
+                    std: hm.std,
+                };
+            }
+            let (ex, ex2) = (m1 / m0, m2 / m0);
+            SlopeHeights {
+                mass: m0,
+                mean: hm.mean + hm.std * ex,
+                std: hm.std * (ex2 - ex * ex).max(0.0).sqrt(),
+            }
+        })
     }
 
     /// The factor of the sun's specular lobe: the lobe's facets (slopes near the posterior mean
-    /// `s*` of [`crate::microfacet::brdf::lobe_posterior`], where the facet slopes meet the base lobe around the half
-    /// vector) are seen with the factor at s*, against the visible slopes' mean of it,
-    /// `c(s*)·E[u⁺]/E[u⁺c]` on the rule of order `points`. 1 where ωo or ωi is below the horizon
-    /// or no half vector exists.
+    /// `s*` of [`crate::microfacet::brdf::lobe_posterior`], where the facet slopes meet the base
+    /// lobe around the half vector) are seen with the lit heights' mass at s*, against the visible
+    /// slopes' mean of it, `c(s*)·E[u⁺]/E[u⁺c]` on the rule of order `points` (`c` = `profile`).
+    /// 1 where ωo or ωi is below the horizon or no half vector exists.
     #[allow(clippy::too_many_arguments)]
     pub fn lobe_factor(
         &self,
+        profile: &[f64; SLOPE_NODES],
         mean: DVec2,
         sigma: &SlopeCov,
         wo: DVec3,
@@ -59,21 +120,116 @@ impl SlopeWeights {
         let (mut plain, mut weighted) = (0.0, 0.0);
         visible_slope_nodes(mean, sigma, wo, points, |n, w| {
             plain += w;
-            weighted += w * self.at(slope_of(n));
+            weighted += w * self.at(profile, slope_of(n));
         });
         if weighted > 0.0 {
-            self.at(post) * plain / weighted
+            self.at(profile, post) * plain / weighted
         } else {
             1.0
         }
     }
 }
 
+/// The colour terms and shading inputs of the jointly weighted visible (height, slope) pairs, in
+/// the form [`Evaluator::radiance`] takes: per slope node j, the visible-slope sums `S_j`, `W_j`
+/// ([`Evaluator::visible_shading_buckets`]), the colour of the heights seen there `C_j` and their
+/// mass `M_j`, under the sun (lit and seen heights) and the environment (seen heights):
+/// `E[C·cos] = Σ_j M_j C_j S_j.cos / Σ_j M_j W_j`, returned as an effective colour per channel
+/// times an effective shading (the sun's terms use `cos`, `cs_cos`; the environment's `env`,
+/// `cs_env`: disjoint, so one [`SlopeShading`] carries both).
+pub(super) struct JointInputs {
+    /// Colour terms under the sun.
+    pub sun: Affine,
+    /// Colour terms under the environment.
+    pub env: Affine,
+    /// The shading inputs.
+    pub shading: SlopeShading,
+}
+
+/// `Σ_j m_j v_j x_j / Σ_j m_j x_j` per channel, or `Σ_j m_j w_j v_j / Σ_j m_j w_j` where no
+/// weight carries `x` (its sums are 0 then anyway).
+fn weighted_terms(
+    m: &[f64; SLOPE_NODES],
+    w: &[f64; SLOPE_NODES],
+    v: &[Affine; SLOPE_NODES],
+    xa: impl Fn(usize, usize) -> f64,
+    xk: impl Fn(usize, usize) -> f64,
+) -> Affine {
+    let mix = |pick: &dyn Fn(&Affine) -> [f64; 3], x: &dyn Fn(usize, usize) -> f64| {
+        [0, 1, 2].map(|c| {
+            let (mut num, mut den, mut fnum, mut fden) = (0.0, 0.0, 0.0, 0.0);
+            for j in 0..SLOPE_NODES {
+                let vj = pick(&v[j])[c];
+                num += m[j] * vj * x(j, c);
+                den += m[j] * x(j, c);
+                fnum += m[j] * w[j] * vj;
+                fden += m[j] * w[j];
+            }
+            if den > 0.0 {
+                num / den
+            } else if fden > 0.0 {
+                fnum / fden
+            } else {
+                pick(&v[SLOPE_NODES / 2])[c]
+            }
+        })
+    };
+    Affine {
+        a: mix(&|v| v.a, &xa),
+        k: mix(&|v| v.k, &xk),
+    }
+}
+
+/// [`JointInputs`] from the slope buckets, the sun's and the environment's masses and colour terms.
+pub(super) fn joint_inputs(
+    buckets: &[(SlopeShading, f64); SLOPE_NODES],
+    sun: (&[f64; SLOPE_NODES], &[Affine; SLOPE_NODES]),
+    env: (&[f64; SLOPE_NODES], &[Affine; SLOPE_NODES]),
+) -> JointInputs {
+    let w: [f64; SLOPE_NODES] = std::array::from_fn(|j| buckets[j].1);
+    let total = |m: &[f64; SLOPE_NODES]| (0..SLOPE_NODES).map(|j| m[j] * w[j]).sum::<f64>();
+    let (ds, de) = (total(sun.0), total(env.0));
+    let mut shading = SlopeShading::default();
+    for (j, (b, _)) in buckets.iter().enumerate() {
+        if ds > 0.0 {
+            let k = sun.0[j] / ds;
+            shading.cos += k * b.cos;
+            for c in 0..3 {
+                shading.cs_cos[c] += k * b.cs_cos[c];
+            }
+        }
+        if de > 0.0 {
+            let k = env.0[j] / de;
+            for c in 0..3 {
+                shading.env[c] += k * b.env[c];
+                shading.cs_env[c] += k * b.cs_env[c];
+            }
+        }
+    }
+    JointInputs {
+        sun: weighted_terms(
+            sun.0,
+            &w,
+            sun.1,
+            |j, _| buckets[j].0.cos,
+            |j, c| buckets[j].0.cs_cos[c],
+        ),
+        env: weighted_terms(
+            env.0,
+            &w,
+            env.1,
+            |j, c| buckets[j].0.env[c],
+            |j, c| buckets[j].0.cs_env[c],
+        ),
+        shading,
+    }
+}
+
 impl Evaluator {
-    /// The masking factor of a footprint of slopes N(mean, Σ) seen from `wo` (world): `None`
-    /// under Smith's masking (`filtering.slope_masking`), for drivers other than the noise (an
-    /// image's process is not a sum of sinusoids, [`Evaluator::slope_masking`] is `None`), at
-    /// the normal (no azimuth) and when no slope is unresolved along the view.
+    /// The masking of a footprint of slopes N(mean, Σ) seen from `wo` (world): `None` under
+    /// Smith's masking (`filtering.slope_masking`), for drivers other than the noise (an image's
+    /// process is not a sum of sinusoids, [`Evaluator::slope_masking`] is `None`), at the normal
+    /// (no azimuth) and when no slope is unresolved along the view.
     pub(crate) fn slope_weights(
         &self,
         footprint: Footprint,
@@ -102,7 +258,7 @@ impl Evaluator {
             dir,
             mean: m,
             sd,
-            profile: table.lookup(dir, scale, nu).slopes,
+            joint: table.lookup(dir, scale, nu),
         })
     }
 }
@@ -120,8 +276,9 @@ mod tests {
             dir: DVec2::X,
             mean: 0.0,
             sd: 0.3,
-            profile: [0.7; SLOPE_NODES],
+            joint: JointMasking::none(),
         };
+        let profile = [0.7; SLOPE_NODES];
         let sigma = SlopeCov {
             xx: 0.09,
             xy: 0.01,
@@ -129,9 +286,18 @@ mod tests {
         };
         let wo = direction(1.3, 0.2);
         let wi = direction(0.9, 2.0);
-        let k = w.lobe_factor(DVec2::new(0.05, 0.0), &sigma, wo, wi, 0.1, 8);
+        let k = w.lobe_factor(&profile, DVec2::new(0.05, 0.0), &sigma, wo, wi, 0.1, 8);
         assert!((k - 1.0).abs() < 1e-12, "{k}");
-        assert_eq!(w.at(DVec2::new(0.4, -0.2)), 0.7);
+        assert_eq!(w.at(&profile, DVec2::new(0.4, -0.2)), 0.7);
+        // Smith's masking (r ≡ 1): every slope node sees D_h itself.
+        let hm = HeightMoments {
+            mean: 1.3,
+            std: 0.6,
+        };
+        for h in w.heights(hm) {
+            assert!((h.mass - 1.0).abs() < 1e-12);
+            assert!((h.mean - hm.mean).abs() < 1e-12 && (h.std - hm.std).abs() < 1e-12);
+        }
     }
 
     #[test]

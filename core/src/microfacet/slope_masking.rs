@@ -22,7 +22,7 @@
 //! slope is `z = t/σ_t` and the ray's slope `ν = μ/σ_t`, with `σ_t = √λ₂` the slope's standard
 //! deviation along d; the result depends on the spectrum's shape alone, not on σ_h.
 
-use crate::math::special::{log_norm_cdf, norm_cdf, norm_pdf};
+use crate::math::special::{log_norm_cdf, norm_cdf, norm_pdf, smith_lambda};
 use serde::{Deserialize, Serialize};
 
 /// How the filtered view's masking and shadowing treat a facet's slope.
@@ -231,12 +231,20 @@ pub fn conditioned_masking_on(grid: &ProcessGrid, nu: f64) -> ConditionedMasking
 
 /// `G1(h₀, t)` on the τ grid of `(R̂, R̂′, R̂″)` at the midpoints of steps `dt` (module docs).
 fn g1(grid: &[(f64, f64, f64)], dt: f64, h0: f64, t: f64, nu: f64) -> f64 {
+    log_g1(grid, dt, h0, t, nu).exp()
+}
+
+/// Largest crossing integral followed: `G1 < e^−700` counts as 0 (`ln G1 = −∞`).
+const MAX_LOG: f64 = 700.0;
+
+/// `ln G1(h₀, t)` ([`g1`]): `−∞` where the start is certainly masked.
+fn log_g1(grid: &[(f64, f64, f64)], dt: f64, h0: f64, t: f64, nu: f64) -> f64 {
     let mut integral = 0.0f64;
     for (i, &(r, r1, r2)) in grid.iter().enumerate() {
         let tau = (i as f64 + 0.5) * dt;
         let ray = h0 + nu * tau;
         if ray > TOP {
-            return (-integral).exp();
+            return -integral;
         }
         let mh = r * h0 - r1 * t;
         let mp = r1 * h0 - r2 * t;
@@ -248,23 +256,87 @@ fn g1(grid: &[(f64, f64, f64)], dt: f64, h0: f64, t: f64, nu: f64) -> f64 {
         let below = norm_cdf(z);
         if below < 1e-300 {
             // The ray is certainly below the conditioned surface: it is crossed.
-            return 0.0;
+            return f64::NEG_INFINITY;
         }
         let m2 = mp + c / vh * (ray - mh) - nu;
         let s2 = (vp - c * c / vh).max(1e-12).sqrt();
         let q = m2 / s2;
         let up = s2 * norm_pdf(q) + m2 * norm_cdf(q);
         integral += up * norm_pdf(z) / sh / below * dt;
-        if integral > 40.0 {
-            // G1 < 5e-18: nothing of this start is seen.
-            return 0.0;
+        if integral > MAX_LOG {
+            return f64::NEG_INFINITY;
         }
     }
     // The process has forgotten the start (or the grid ends): Smith's tail in closed form.
     let ray = h0 + nu * grid.len() as f64 * dt;
     let excess = norm_pdf(nu) - nu * norm_cdf(-nu);
     integral -= excess.max(0.0) / nu * log_norm_cdf(ray);
-    (-integral).exp()
+    -integral
+}
+
+/// Bound on `|ln r|` of [`JointMasking`]: where the conditioned and Smith's masking differ by more
+/// than e⁸ both are below anything D_h weights.
+pub const MAX_LOG_RATIO: f64 = 8.0;
+
+/// Masking conditioned on the start's height and slope jointly, relative to Smith's:
+/// `ln r(h_i, z_j) = ln G1(h_i, z_j) − Λ(ν)·ln Φ(h_i)` at the heights of [`height_node`] and the
+/// slopes of [`slope_node`], clamped to ±[`MAX_LOG_RATIO`]. Smith's `Φ(h)^Λ` [HN12 Eqs. 4–6] is
+/// what the views' D_h already carries; `r` is the share the slope moves, and it is not
+/// separable: high starts are seen at every slope, low ones mostly when they face the eye.
+/// Back faces (`z ≥ ν`) hold the last front row, as in [`conditioned_masking`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointMasking {
+    /// `ln r`, height-major: `log_ratio[i][j]` at `(height_node(i), slope_node(j))`.
+    pub log_ratio: [[f64; SLOPE_NODES]; HEIGHT_NODES],
+}
+
+impl JointMasking {
+    /// Smith's masking: `r ≡ 1`.
+    pub fn none() -> Self {
+        Self {
+            log_ratio: [[0.0; SLOPE_NODES]; HEIGHT_NODES],
+        }
+    }
+
+    /// `ln r(h, z_j)` at height `h` (σ_h units), linear between the height nodes and clamped to
+    /// the end nodes (NaN reads height 0).
+    pub fn log_ratio_at(&self, h: f64, j: usize) -> f64 {
+        let h = if h.is_nan() { 0.0 } else { h };
+        let x = (h - height_node(0)).clamp(0.0, (HEIGHT_NODES - 1) as f64);
+        let i = (x as usize).min(HEIGHT_NODES - 2);
+        let f = x - i as f64;
+        self.log_ratio[i][j] * (1.0 - f) + self.log_ratio[i + 1][j] * f
+    }
+}
+
+/// [`JointMasking`] of a ray of slope `nu` (in σ_t) on a grid built for rays at most as grazing.
+/// Edge cases as [`conditioned_masking`]: `ν ≥ 8`, `ν ≤ 0` or NaN give Smith's (`r ≡ 1`; there
+/// nothing is seen, or nothing masked). Always finite.
+pub fn joint_masking_on(grid: &ProcessGrid, nu: f64) -> JointMasking {
+    let mut out = JointMasking::none();
+    if !(nu > 0.0 && nu < 8.0) {
+        return out;
+    }
+    let lambda = smith_lambda(nu / std::f64::consts::SQRT_2);
+    let (dt, values) = (grid.dt, &grid.values[..grid.memory]);
+    for j in 0..SLOPE_NODES {
+        let t = slope_node(j);
+        for i in 0..HEIGHT_NODES {
+            out.log_ratio[i][j] = if t >= nu {
+                // A back face holds the last front value (see conditioned_masking_on).
+                if j > 0 { out.log_ratio[i][j - 1] } else { 0.0 }
+            } else {
+                let h = height_node(i);
+                let d = log_g1(values, dt, h, t, nu) - lambda * log_norm_cdf(h);
+                if d.is_nan() {
+                    0.0
+                } else {
+                    d.clamp(-MAX_LOG_RATIO, MAX_LOG_RATIO)
+                }
+            };
+        }
+    }
+    out
 }
 
 /// Linear interpolation of a [`conditioned_masking`] profile at slope `z` (in σ_t), clamped to
@@ -280,7 +352,6 @@ pub fn profile_at(profile: &[f64; SLOPE_NODES], z: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::math::special::smith_lambda;
 
     /// A process of many components over two octaves of frequency, all directions.
     fn broad() -> LineProcess {
