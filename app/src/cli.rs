@@ -37,10 +37,11 @@ pub enum Command {
         /// Ground-truth samples (eye rays) for the patch (2 to 10⁸: its standard error needs two).
         #[arg(long, default_value_t = 40_000, value_parser = eval_samples)]
         spp: usize,
-        /// The filtered model's masking of the visible slopes: Smith's (the views'), or conditioned
-        /// on the facet's slope along the ray (#17; core only so far, noise drivers).
-        #[arg(long, value_enum, default_value_t = SlopeMaskingArg::Smith)]
-        slope_masking: SlopeMaskingArg,
+        /// The filtered model's masking of the visible slopes, overriding the preset's: Smith's
+        /// (height alone), or conditioned on the facet's height and slope along the ray jointly
+        /// (#17; the default; noise drivers).
+        #[arg(long, value_enum)]
+        slope_masking: Option<SlopeMaskingArg>,
         /// Print JSON instead of a table.
         #[arg(long)]
         json: bool,
@@ -281,7 +282,7 @@ pub enum Command {
 pub enum SlopeMaskingArg {
     /// Smith's: visibility depends on the height alone.
     Smith,
-    /// Conditioned on the facet's slope along the ray.
+    /// Conditioned on the facet's height and slope along the ray jointly (the default).
     Conditioned,
 }
 

@@ -179,7 +179,9 @@ fn run(cli: Cli) -> Result<()> {
             json,
         }) => {
             let mut preset = preset.clone();
-            preset.material.filtering.slope_masking = slope_masking.into();
+            if let Some(sm) = slope_masking {
+                preset.material.filtering.slope_masking = sm.into();
+            }
             let r = eval::eval(
                 &preset,
                 [view_deg, view_azimuth_deg, light_deg, light_azimuth_deg],

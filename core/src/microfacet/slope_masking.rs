@@ -28,14 +28,13 @@ use serde::{Deserialize, Serialize};
 /// How the filtered view's masking and shadowing treat a facet's slope.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, Default)]
 pub enum SlopeMasking {
-    /// Smith's: visibility depends on the height alone (the papers' model; default).
-    #[default]
+    /// Smith's: visibility depends on the height alone (the papers' model, [HN12 Eqs. 4–6]).
     Smith,
-    /// Masking conditioned on the slope along the view ([`conditioned_masking`]); noise drivers
-    /// only (image drivers keep Smith's). Not the default yet: it helps at grazing views with the
-    /// light at the normal or on the viewer's side, and errs the other way with the light opposite,
-    /// where the colour of D_h and the shading of D_s, reweighted separately, miss that G1 couples
-    /// height and slope (docs/design.md).
+    /// Masking conditioned on the facet's height and slope along the view jointly
+    /// ([`JointMasking`]; default): each visible slope sees its own heights, so the colour (which
+    /// follows the height) and the shading (which follows the slope) are summed together. Noise
+    /// drivers only: an image driver's process is not a sum of sinusoids, and it keeps Smith's.
+    #[default]
     Conditioned,
 }
 
