@@ -170,6 +170,8 @@ pub fn wgsl_prelude() -> &'static str {
                 conditional_slopes::INVERSE_SIZE as u32,
             ),
             ("SLOPE_NODES", slope_masking::SLOPE_NODES as u32),
+            ("HEIGHT_NODES", slope_masking::HEIGHT_NODES as u32),
+            ("TABLE_ENTRY", slope_masking_table::ENTRY as u32),
             ("TABLE_AZIMUTHS", slope_masking_table::TABLE_AZIMUTHS as u32),
             ("TABLE_LEVELS", slope_masking_table::TABLE_LEVELS as u32),
             ("TABLE_NUS", slope_masking_table::TABLE_NUS as u32),
@@ -193,6 +195,7 @@ pub fn wgsl_prelude() -> &'static str {
             ("HISTOGRAM_G_END", G_END),
             ("TABLE_NU_MIN", slope_masking_table::NU_MIN),
             ("TABLE_NU_RATIO", slope_masking_table::NU_RATIO),
+            ("HEIGHT_NODE_DEPTH", -slope_masking::height_node(0)),
         ];
         for (name, v) in floats {
             let _ = writeln!(s, "const {name}: f32 = {:?};", v as f32);
@@ -207,10 +210,14 @@ pub fn wgsl_prelude() -> &'static str {
 mod tests {
     use super::*;
 
-    /// The WGSL packs a slope-masking profile in a 3 × 3 matrix (`microfacet/slope_masking.wgsl`).
+    /// The WGSL packs a slope-masking profile in a 3 × 3 matrix and the joint masking in an
+    /// array of 90 (`microfacet/slope_masking.wgsl`: literal sizes, which the GLSL export
+    /// round-trips).
     #[test]
     fn a_slope_masking_profile_fills_a_three_by_three_matrix() {
         assert_eq!(slope_masking::SLOPE_NODES, 9);
+        assert_eq!(slope_masking::HEIGHT_NODES * slope_masking::SLOPE_NODES, 90);
+        assert_eq!(slope_masking_table::ENTRY, 90);
     }
 
     /// Every constant is declared once, and the f32 literals read back as the same f32.

@@ -30,9 +30,7 @@ const LIGHTS: [(f64, f64); 3] = [(0.0, 0.0), (30.0, 0.0), (30.0, 180.0)];
 /// docs/design.md). (Snow under sky at 85°, 5–6% beyond the truth's noise with Smith's masking,
 /// met the goal once the masking was conditioned on height and slope jointly: 1.4–1.5%. Terraces, 1.3–1.6% at 0° and
 /// 60° with the transfer mixture's 8 bins, met the goal once the mixture had 16: 0.6–0.9%.)
-const KNOWN: &[(&str, f64, f64, f64, f64)] = &[
-    ("cobblestones.ron", 85.0, 0.0, 0.0, 0.087),
-];
+const KNOWN: &[(&str, f64, f64, f64, f64)] = &[("cobblestones.ron", 85.0, 0.0, 0.0, 0.087)];
 
 /// The goal of #17 at a view angle.
 fn goal(view_deg: f64) -> f64 {

@@ -10,14 +10,14 @@
 //! over the driver's value instead of one Gaussian ([`crate::eval::mixture_bins`]).
 
 use crate::driver::field::DriverField;
-use crate::eval::{Evaluator, FootprintQuery};
-use crate::material::transfer::TransferFunction;
 use crate::eval::slope_weights::joint_inputs;
+use crate::eval::{Evaluator, FootprintQuery};
 use crate::material::color_terms::Affine;
+use crate::material::transfer::TransferFunction;
 use crate::microfacet::effective_height::{HeightMoments, height_moments};
-use crate::microfacet::slope_masking::SLOPE_NODES;
 use crate::microfacet::masking_shadowing::G2;
 use crate::microfacet::slope_density::{NoiseSlopes, sinusoid_density_ratio};
+use crate::microfacet::slope_masking::SLOPE_NODES;
 use crate::microfacet::slopes::{normal_of, slope_of};
 use crate::scene::direction::basis;
 use glam::{DMat3, DVec2, DVec3};
@@ -114,9 +114,8 @@ impl Evaluator {
                     } else {
                         sun
                     };
-                    let buckets = self.visible_shading_buckets(
-                        mean, &sigma, cfg.wo, cfg.wi, frame, points, &w,
-                    );
+                    let buckets = self
+                        .visible_shading_buckets(mean, &sigma, cfg.wo, cfg.wi, frame, points, &w);
                     let joint = joint_inputs(&buckets, (&sun.0, &sun.1), (&env.0, &env.1));
                     let k = w.lobe_factor(
                         &sun.0,

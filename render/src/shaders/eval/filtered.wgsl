@@ -27,11 +27,9 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
     // The colour model over the visible and lit heights (L = Λo + Λi) for the directional light,
     // over the visible heights (L = Λo) for the unshadowed environment.
     let hm = height_moments(ms.total);
-    let sun_color = affine(color_of_distribution(d.x + d.y * hm.mean, d.y * hm.std_dev, ms.total, vec2<f32>(hm.mean, hm.std_dev), d.y * d.y));
-    var env_color = sun_color;
+    var hmo = hm;
 //#if environment
-    let hmo = height_moments(ms.lambda_o);
-    env_color = affine(color_of_distribution(d.x + d.y * hmo.mean, d.y * hmo.std_dev, ms.lambda_o, vec2<f32>(hmo.mean, hmo.std_dev), d.y * d.y));
+    hmo = height_moments(ms.lambda_o);
 //#endif
     var vbar = 0.0;
     if (wi.z > 0.0 && wi_w.z > 0.0) {
@@ -41,16 +39,36 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
     }
     // The footprint's slopes are N(s̄, Σ) in world slope space, exactly: average the facets there.
     let s_mean = loc.stats.slope_mean;
-    // Slope-conditioned masking (#17) reweights the visible slopes and the sun's lobe.
-    let weights = slope_weights(fp, s_mean, cov, wo_w);
-    let shading = visible_shading(s_mean, cov, wo_w, wi_w, weights);
     let lit = sun_visible * vbar;
     var spec = specular_lobes(s_mean, cov, wo_w, wi_w);
-//#if specular|measured
-    if (weights.on) {
-        spec = spec * lobe_factor(weights, s_mean, cov, wo_w, wi_w, params.roughness, params.slope_rule_offset, params.slope_points);
-    }
+    var sun_color: Affine;
+    var env_color: Affine;
+    var shading: SlopeShading;
+    let weights = slope_weights(fp, s_mean, cov, wo_w);
+    if (!weights.on) {
+        sun_color = affine(color_of_distribution(d.x + d.y * hm.mean, d.y * hm.std_dev, ms.total, vec2<f32>(hm.mean, hm.std_dev), d.y * d.y));
+        env_color = sun_color;
+//#if environment
+        env_color = affine(color_of_distribution(d.x + d.y * hmo.mean, d.y * hmo.std_dev, ms.lambda_o, vec2<f32>(hmo.mean, hmo.std_dev), d.y * d.y));
 //#endif
+        shading = visible_shading(s_mean, cov, wo_w, wi_w);
+    } else {
+        // Masking conditioned on height and slope jointly (#17): each slope node sees its own
+        // heights, so colour and shading are summed together.
+        let sun_h = slope_heights(hm);
+        var env_h = sun_h;
+//#if environment
+        env_h = slope_heights(hmo);
+//#endif
+        visible_shading_buckets(s_mean, cov, wo_w, wi_w, params.slope_rule_offset, params.slope_points, weights);
+        let joint = joint_inputs(sun_h, env_h, d, ms.total, hm, ms.lambda_o, hmo);
+        sun_color = joint.sun;
+        env_color = joint.env;
+        shading = joint.shading;
+//#if specular|measured
+        spec = spec * lobe_factor(weights, sun_h.mass, s_mean, cov, wo_w, wi_w, params.roughness, params.slope_rule_offset, params.slope_points);
+//#endif
+    }
     // The density ratio scales only the sun's specular term: skipped where it changes nothing.
     if (any(spec > vec3<f32>(0.0)) && lit > 0.0 && params.sun != 0.0) {
         spec = spec * lobe_density_ratio(fp, s_mean, wo_w, wi_w);

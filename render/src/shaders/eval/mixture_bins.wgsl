@@ -99,9 +99,7 @@ fn filtered_bins(loc: FootprintStats, wo_w: vec3<f32>, wi_w: vec3<f32>, wo: vec3
         let w2 = bin_masking(lo, hi, ms.total, above);
         above_o = above_o + bin_exponent(lo, hi, ms.lambda_o);
         above = above + bin_exponent(lo, hi, ms.total);
-        var no_weights: SlopeWeights;
-        no_weights.on = false;
-        let sums = visible_shading_sums(s_mean, cov, wo_w, wi_w, params.mix_rule_offset, params.mix_points, no_weights);
+        let sums = visible_shading_sums(s_mean, cov, wo_w, wi_w, params.mix_rule_offset, params.mix_points);
         den = den + w1 * sums.den;
         var v = 0.0;
         var spec = vec3<f32>(0.0);

@@ -194,8 +194,8 @@ fn has_environment() -> bool {
 //#if relief
 // Evaluator::visible_shading: point_shading averaged on the nodes of D_s (visible_slope_nodes),
 // world slope space, slopes N(mean, cov).
-fn visible_shading(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, weights: SlopeWeights) -> SlopeShading {
-    let sums = visible_shading_sums(mean, cov, wo, wi, params.slope_rule_offset, params.slope_points, weights);
+fn visible_shading(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> SlopeShading {
+    let sums = visible_shading_sums(mean, cov, wo, wi, params.slope_rule_offset, params.slope_points);
     var acc = sums.s;
     if (sums.den > 0.0) {
         let inv = 1.0 / sums.den;
@@ -213,9 +213,8 @@ struct ShadingSums {
     den: f32,
 }
 
-// Evaluator::visible_shading_sums, on the n × n rule stored at `rule_off`; with slope-conditioned
-// masking (#17) each node × its masking factor.
-fn visible_shading_sums(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, rule_off: u32, points: u32, weights: SlopeWeights) -> ShadingSums {
+// Evaluator::visible_shading_sums, on the n × n rule stored at `rule_off`.
+fn visible_shading_sums(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, rule_off: u32, points: u32) -> ShadingSums {
     let l = cholesky(cov);
     let nodes = points * points;
     var acc: SlopeShading;
@@ -229,12 +228,9 @@ fn visible_shading_sums(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3
         let z = vec3<f32>(datum(b), datum(b + 1u), datum(b + 2u));
         let s = mean + vec2<f32>(l.x * z.x, l.y * z.x + l.z * z.y);
         let u = max(wo.z - s.x * wo.x - s.y * wo.y, 0.0);
-        var wt = z.z * u;
+        let wt = z.z * u;
         if (wt > 0.0) {
             let n = normal_of(s);
-            if (weights.on) {
-                wt = wt * slope_weights_at(weights, slope_of(n));
-            }
             let p = point_shading(n, wi);
             acc.cos = acc.cos + wt * p.cos;
             acc.cs_cos = acc.cs_cos + wt * p.cs_cos;
@@ -244,5 +240,60 @@ fn visible_shading_sums(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3
         }
     }
     return ShadingSums(acc, den);
+}
+
+// The visible shading split over the slope nodes (SLOPE_NODES = 9), as
+// visible_shading_buckets leaves it: each bucket's unnormalised SlopeShading sums and weight,
+// field by field (the GLSL export round-trips neither arrays of structs nor structs of arrays).
+var<private> bucket_cos: array<f32, 9>;
+var<private> bucket_cs_cos: array<vec3<f32>, 9>;
+var<private> bucket_env: array<vec3<f32>, 9>;
+var<private> bucket_cs_env: array<vec3<f32>, 9>;
+var<private> bucket_w: array<f32, 9>;
+
+// Bucket j's sums as a SlopeShading.
+fn bucket(j: u32) -> SlopeShading {
+    return SlopeShading(bucket_cos[j], bucket_cs_cos[j], bucket_env[j], bucket_cs_env[j]);
+}
+
+// Evaluator::visible_shading_buckets: each visible node to the two slope nodes around its slope
+// along the view, with linear (hat) weights (into the bucket arrays).
+fn visible_shading_buckets(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, rule_off: u32, points: u32, weights: SlopeWeights) {
+    let l = cholesky(cov);
+    let nodes = points * points;
+    for (var j = 0u; j < SLOPE_NODES; j = j + 1u) {
+        bucket_cos[j] = 0.0;
+        bucket_cs_cos[j] = vec3<f32>(0.0);
+        bucket_env[j] = vec3<f32>(0.0);
+        bucket_cs_env[j] = vec3<f32>(0.0);
+        bucket_w[j] = 0.0;
+    }
+    for (var i = 0u; i < nodes; i = i + 1u) {
+        let b = rule_off + 3u * i;
+        let z = vec3<f32>(datum(b), datum(b + 1u), datum(b + 2u));
+        let s = mean + vec2<f32>(l.x * z.x, l.y * z.x + l.z * z.y);
+        let u = max(wo.z - s.x * wo.x - s.y * wo.y, 0.0);
+        let wt = z.z * u;
+        if (wt > 0.0) {
+            let n = normal_of(s);
+            var c = slope_weights_coordinate(weights, slope_of(n));
+            if (c != c) {
+                c = 0.0;
+            }
+            let x = clamp(c + 4.0, 0.0, f32(SLOPE_NODES - 1u));
+            let j0 = min(u32(x), SLOPE_NODES - 2u);
+            let f = x - f32(j0);
+            let p = point_shading(n, wi);
+            for (var e = 0u; e < 2u; e = e + 1u) {
+                let j = j0 + e;
+                let wj = wt * select(1.0 - f, f, e == 1u);
+                bucket_cos[j] = bucket_cos[j] + wj * p.cos;
+                bucket_cs_cos[j] = bucket_cs_cos[j] + wj * p.cs_cos;
+                bucket_env[j] = bucket_env[j] + wj * p.env;
+                bucket_cs_env[j] = bucket_cs_env[j] + wj * p.cs_env;
+                bucket_w[j] = bucket_w[j] + wj;
+            }
+        }
+    }
 }
 //#endif

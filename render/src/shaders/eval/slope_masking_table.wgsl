@@ -1,12 +1,13 @@
 // Mirror of `core/src/eval/slope_masking_table.rs`: the material's table of slope-conditioned
 // masking (#17), at params.cm_offset: r0, the ln step between footprint levels, then
-// TABLE_AZIMUTHS × TABLE_LEVELS × TABLE_NUS profiles of SLOPE_NODES values (ν fastest).
+// TABLE_AZIMUTHS × TABLE_LEVELS × TABLE_NUS entries (ν fastest) of TABLE_ENTRY values, ln r at
+// HEIGHT_NODES × SLOPE_NODES nodes (height-major).
 // `//#if feature` blocks are stripped by render/src/specialize.rs when a scene does not use the feature.
 
 //#if relief
 // SlopeMaskingTable::lookup: multilinear over the azimuth (periodic over π), ln r and ln ν,
-// clamped at the ends.
-fn slope_masking_lookup(dir: vec2<f32>, r: f32, nu: f32) -> SlopeProfile {
+// clamped at the ends, into joint_masking.
+fn slope_masking_lookup(dir: vec2<f32>, r: f32, nu: f32) {
     let base = params.cm_offset;
     let r0 = datum(base);
     let level_step = datum(base + 1u);
@@ -34,7 +35,9 @@ fn slope_masking_lookup(dir: vec2<f32>, r: f32, nu: f32) -> SlopeProfile {
     let fl = lv - f32(l0);
     let n0 = min(u32(nv), TABLE_NUS - 2u);
     let fn_ = nv - f32(n0);
-    var acc = mat3x3<f32>(vec3<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0));
+    for (var j = 0u; j < TABLE_ENTRY; j = j + 1u) {
+        joint_masking[j] = 0.0;
+    }
     for (var k = 0u; k < 8u; k = k + 1u) {
         let a = select(a0, a1, (k & 1u) != 0u);
         let l = l0 + ((k >> 1u) & 1u);
@@ -45,11 +48,10 @@ fn slope_masking_lookup(dir: vec2<f32>, r: f32, nu: f32) -> SlopeProfile {
         if (w == 0.0) {
             continue;
         }
-        let e = base + 2u + ((a * TABLE_LEVELS + l) * TABLE_NUS + n) * SLOPE_NODES;
-        for (var j = 0u; j < SLOPE_NODES; j = j + 1u) {
-            acc[j / 3u][j % 3u] = acc[j / 3u][j % 3u] + w * datum(e + j);
+        let e = base + 2u + ((a * TABLE_LEVELS + l) * TABLE_NUS + n) * TABLE_ENTRY;
+        for (var j = 0u; j < TABLE_ENTRY; j = j + 1u) {
+            joint_masking[j] = joint_masking[j] + w * datum(e + j);
         }
     }
-    return SlopeProfile(acc);
 }
 //#endif

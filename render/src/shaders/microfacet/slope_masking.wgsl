@@ -1,19 +1,23 @@
-// Mirror of `core/src/microfacet/slope_masking.rs` (the lookup half: the profiles themselves are
+// Mirror of `core/src/microfacet/slope_masking.rs` (the lookup half: the masking itself is
 // tabulated on the CPU, `eval/slope_masking_table.wgsl`).
 // `//#if feature` blocks are stripped by render/src/specialize.rs when a scene does not use the feature.
 
 //#if relief
-// ConditionedMasking's slope profile: its SLOPE_NODES = 9 values, node j at m[j / 3][j % 3] (a
-// matrix, not an array: the GLSL the export translates to does not round-trip arrays of a
-// constant's size; render's gpu_codes tests that SLOPE_NODES is 9).
+// A slope profile: SLOPE_NODES = 9 values, node j at m[j / 3][j % 3] (a matrix, not an array:
+// the GLSL the export translates to does not round-trip arrays of a constant's size; render's
+// gpu_codes tests that SLOPE_NODES is 9).
 struct SlopeProfile {
     m: mat3x3<f32>,
+}
+
+// Node j of a profile.
+fn profile_node(p: SlopeProfile, j: u32) -> f32 {
+    return p.m[j / 3u][j % 3u];
 }
 
 // slope_masking::profile_at: linear between the profile's nodes (slopes −4 to 4 by 1, in σ_t),
 // clamped to the ends; NaN reads the value at 0.
 fn profile_at(profile: SlopeProfile, z: f32) -> f32 {
-    var p = profile.m;
     var zz = z;
     if (zz != zz) {
         zz = 0.0;
@@ -21,7 +25,23 @@ fn profile_at(profile: SlopeProfile, z: f32) -> f32 {
     let x = clamp(zz + 4.0, 0.0, f32(SLOPE_NODES - 1u));
     let i = min(u32(x), SLOPE_NODES - 2u);
     let f = x - f32(i);
-    let j = i + 1u;
-    return p[i / 3u][i % 3u] * (1.0 - f) + p[j / 3u][j % 3u] * f;
+    return profile_node(profile, i) * (1.0 - f) + profile_node(profile, i + 1u) * f;
+}
+
+// JointMasking of the pixel being shaded: ln r at HEIGHT_NODES × SLOPE_NODES (= 90, tested in
+// gpu_codes) nodes, height-major, written by slope_masking_lookup.
+var<private> joint_masking: array<f32, 90>;
+
+// JointMasking::log_ratio_at: ln r(h, z_j), linear between the height nodes (h in σ_h, from
+// −HEIGHT_NODE_DEPTH by 1), clamped to the end nodes; NaN reads height 0.
+fn log_ratio_at(h: f32, j: u32) -> f32 {
+    var hh = h;
+    if (hh != hh) {
+        hh = 0.0;
+    }
+    let x = clamp(hh + HEIGHT_NODE_DEPTH, 0.0, f32(HEIGHT_NODES - 1u));
+    let i = min(u32(x), HEIGHT_NODES - 2u);
+    let f = x - f32(i);
+    return joint_masking[i * SLOPE_NODES + j] * (1.0 - f) + joint_masking[(i + 1u) * SLOPE_NODES + j] * f;
 }
 //#endif
