@@ -192,9 +192,10 @@ pub fn material_cases() -> Vec<MaterialCase> {
             reference: Reference::Same {
                 material: Box::new(with_sigmas(0.05, 0.35 / r.sqrt(), 0.35 * r.sqrt())),
                 mirrored: true,
-                // The specular lobe's exact slope density depends on the realised waves, which
-                // are isotropic in distribution but not mirror-symmetric: 5e-8 measured.
-                bound: 1e-6,
+                // The specular lobe's exact slope density and the slope-conditioned masking's
+                // table depend on the realised waves, which are isotropic in distribution but not
+                // mirror-symmetric: 5e-8 measured with Smith's masking, 2.1e-6 with the joint.
+                bound: 1e-5,
                 what: "the transposed anisotropy seen mirrored across x = y (the noise is isotropic)",
             },
         });
