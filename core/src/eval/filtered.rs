@@ -75,7 +75,11 @@ impl Evaluator {
                 .of_distribution(m + s * mean, s * std, l, (hm.mean, hm.std), s * s)
         };
         let hm_sun = height_moments(ms.total, f.height_filter);
-        let hm_env = height_moments(ms.lambda_o, f.height_filter);
+        let hm_env = if self.environment.is_some() {
+            height_moments(ms.lambda_o, f.height_filter)
+        } else {
+            hm_sun
+        };
         let vbar = if wi.z > 0.0 && cfg.wi.z > 0.0 {
             ms.mean_shadowing()
         } else {
@@ -87,7 +91,7 @@ impl Evaluator {
         let mut spec = self.specular_lobes(mean, &sigma, cfg.wo, cfg.wi);
         let points = f.slope_points as usize;
         let (sun_color, env_color, shading) =
-            match self.slope_weights(cfg.footprint, mean, &sigma, cfg.wo) {
+            match self.slope_weights(cfg.footprint, mean, &sigma, cfg.wo, [hm_sun, hm_env]) {
                 None => {
                     let sun = terms.affine(color_of(ms.total, hm_sun, (hm_sun.mean, hm_sun.std)));
                     let env = if self.environment.is_some() {
@@ -124,7 +128,7 @@ impl Evaluator {
                         cfg.wo,
                         cfg.wi,
                         self.material.brdf.roughness,
-                        points,
+                        &buckets.map(|b| b.1),
                     );
                     spec = spec.map(|v| v * k);
                     (joint.sun, joint.env, joint.shading)

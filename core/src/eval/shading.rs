@@ -3,15 +3,13 @@
 //! [HNPN14 Sec. 6] under the directional light and the environment [HNPN14 Sec. 5.3].
 
 use crate::eval::Evaluator;
-use crate::eval::slope_weights::SlopeWeights;
 use crate::material::color_terms::Affine;
 use crate::material::measured::ChannelWeights;
 use crate::material::merl_fit::fresnel_factor;
 use crate::math::gaussian::cholesky;
 use crate::microfacet::brdf::{BaseBrdf, filtered_specular, half_vector_posterior};
-use crate::microfacet::slope_masking::{SLOPE_NODES, slope_node};
 use crate::microfacet::slopes::SlopeCov;
-use crate::microfacet::slopes::{normal_of, slope_of};
+use crate::microfacet::slopes::normal_of;
 use crate::microfacet::visible_slopes::visible_slope_nodes;
 use crate::scene::direction::basis;
 use glam::{DMat3, DVec2, DVec3};
@@ -121,39 +119,6 @@ impl Evaluator {
             acc.add(&self.point_shading(n, wi, frame), w);
         });
         (acc, den)
-    }
-
-    /// [`Evaluator::visible_shading_sums`] split over the slope nodes of `weights` (slope along
-    /// the view in the unresolved deviations, [`SlopeWeights::coordinate`]): each visible node
-    /// goes to the two slope nodes around it with linear (hat) weights, so that a quantity linear
-    /// between the slope nodes, summed per node against these, is its exact sum over the visible
-    /// nodes ([`crate::eval::slope_weights::joint_inputs`]). Unnormalised, with each bucket's
-    /// weight.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn visible_shading_buckets(
-        &self,
-        mean: DVec2,
-        sigma: &SlopeCov,
-        wo: DVec3,
-        wi: DVec3,
-        frame: &DMat3,
-        points: usize,
-        weights: &SlopeWeights,
-    ) -> [(SlopeShading, f64); SLOPE_NODES] {
-        let mut out = [(SlopeShading::default(), 0.0); SLOPE_NODES];
-        visible_slope_nodes(mean, sigma, wo, points, |n, w| {
-            let z = weights.coordinate(slope_of(n));
-            let x = (if z.is_nan() { 0.0 } else { z } - slope_node(0))
-                .clamp(0.0, (SLOPE_NODES - 1) as f64);
-            let j = (x as usize).min(SLOPE_NODES - 2);
-            let f = x - j as f64;
-            let p = self.point_shading(n, wi, frame);
-            for (k, wk) in [(j, w * (1.0 - f)), (j + 1, w * f)] {
-                out[k].0.add(&p, wk);
-                out[k].1 += wk;
-            }
-        });
-        out
     }
 
     /// Radiance from the combined colour `A + K ⊙ C_s` (`sun_color` under the directional light,

@@ -16,7 +16,7 @@
 
 use crate::driver::noise::SumOfSines;
 use crate::microfacet::slope_masking::{
-    HEIGHT_NODES, JointMasking, LineProcess, ProcessGrid, SLOPE_NODES, joint_masking_on,
+    HEIGHT_NODES, JointMasking, LineProcess, ProcessGrid, SLOPE_NODES, joint_masking_on, slope_node,
 };
 use glam::DVec2;
 use rayon::prelude::*;
@@ -130,8 +130,13 @@ impl SlopeMaskingTable {
 
     /// The masking for a ray of horizontal direction `dir` (unit), a footprint of standard
     /// deviation `r` along it and slope `nu`: `ln r` multilinear between the nodes (module
-    /// docs). Non-finite inputs are clamped to the first nodes.
-    pub fn lookup(&self, dir: DVec2, r: f64, nu: f64) -> JointMasking {
+    /// docs), at the height rows `rows.0..=rows.1` ([`crate::microfacet::slope_masking::height_rows`]
+    /// of the heights the caller reads; the others stay 0: on the GPU the lookup is the filtered
+    /// view's largest cost, and a grazing view's D_h covers 4–7 of the 10 rows). Of each entry
+    /// only the front slopes are read ([`front_columns`]); the back faces hold the last front
+    /// value in the table, so they get it without reading it again (the same sum). Non-finite
+    /// inputs are clamped to the first nodes.
+    pub fn lookup(&self, dir: DVec2, r: f64, nu: f64, rows: (usize, usize)) -> JointMasking {
         let (a0, a1, fa) = azimuth_coordinate(dir);
         let lv = if r > 0.0 && r.is_finite() {
             ((self.r0 / r).ln() / self.level_step).clamp(0.0, (TABLE_LEVELS - 1) as f64)
@@ -149,6 +154,8 @@ impl SlopeMaskingTable {
         };
         let (l0, fl) = split(lv, TABLE_LEVELS);
         let (n0, fn_) = split(nv, TABLE_NUS);
+        let (first, last) = (rows.0.min(HEIGHT_NODES - 1), rows.1.min(HEIGHT_NODES - 1));
+        let span = first * SLOPE_NODES..(last + 1) * SLOPE_NODES;
         let mut acc = [0.0f64; ENTRY];
         for (a, wa) in [(a0, 1.0 - fa), (a1, fa)] {
             for (l, wl) in [(l0, 1.0 - fl), (l0 + 1, fl)] {
@@ -158,8 +165,12 @@ impl SlopeMaskingTable {
                         continue;
                     }
                     let base = ((a * TABLE_LEVELS + l) * TABLE_NUS + n) * ENTRY;
-                    for (o, v) in acc.iter_mut().zip(&self.data[base..base + ENTRY]) {
-                        *o += w * f64::from(*v);
+                    let front = front_columns(n);
+                    for row in span.clone().step_by(SLOPE_NODES) {
+                        let entry = &self.data[base + row..base + row + SLOPE_NODES];
+                        for (j, o) in acc[row..row + SLOPE_NODES].iter_mut().enumerate() {
+                            *o += w * f64::from(entry[j.min(front - 1)]);
+                        }
                     }
                 }
             }
@@ -175,6 +186,13 @@ impl SlopeMaskingTable {
 /// ν of node `j`.
 pub fn nu_node(j: usize) -> f64 {
     NU_MIN * NU_RATIO.powi(j as i32)
+}
+
+/// The slope columns of ν node `n` that are front faces, `z_j < ν_n` (`z_j = j − 4`): the first
+/// `⌈ν_n + 4⌉` (5 to 9, since ν > 0); the rest hold the last of them
+/// ([`crate::microfacet::slope_masking::joint_masking_on`]).
+pub fn front_columns(n: usize) -> usize {
+    ((nu_node(n) - slope_node(0)).ceil() as usize).clamp(1, SLOPE_NODES)
 }
 
 /// The two azimuth nodes around `dir` and the weight of the second (periodic over π).
@@ -199,8 +217,10 @@ fn split(x: f64, n: usize) -> (usize, f64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::eval::slope_weights::{SlopeWeights, height_span};
     use crate::eval::test_materials::preset;
-    use crate::microfacet::slope_masking::{MAX_LOG_RATIO, height_node, slope_node};
+    use crate::microfacet::effective_height::HeightMoments;
+    use crate::microfacet::slope_masking::{MAX_LOG_RATIO, height_node};
 
     #[test]
     fn the_lookup_between_nodes_follows_the_direct_masking() {
@@ -222,7 +242,7 @@ mod tests {
             }))
             .expect("process");
             let direct = joint_masking_on(&ProcessGrid::new(&process, nu), nu);
-            let looked = table.lookup(dir, r, nu);
+            let looked = table.lookup(dir, r, nu, (0, HEIGHT_NODES - 1));
             // From −0.5σ up and on the front slopes, the ratio r within 6% (ln r within 0.06).
             // Below, the interpolation in ν is off by up to 0.07 at ν = 0.25 (h = −1.5σ), where
             // D_h of L = Λo holds 8% of its mass.
@@ -238,6 +258,29 @@ mod tests {
                 }
             }
         }
+        // The rows a D_h reads are those its lookup fills: restricted and full lookups give the
+        // same heights at every slope node.
+        let dir = DVec2::from_angle(0.7);
+        for (mean, std) in [(0.56, 0.83), (2.4, 0.35), (-0.2, 1.0), (5.0, 0.2)] {
+            let hm = HeightMoments { mean, std };
+            let weights = |joint| SlopeWeights {
+                dir,
+                mean: 0.0,
+                sd: 1.0,
+                joint,
+            };
+            let full = weights(table.lookup(dir, table.r0, 0.4, (0, HEIGHT_NODES - 1)));
+            let part = weights(table.lookup(dir, table.r0, 0.4, height_span([hm; 2])));
+            assert_eq!(full.heights(hm), part.heights(hm), "D_h ({mean}, {std})");
+        }
+        // Every back-face column of the table holds its entry's last front value (what the lookup
+        // relies on to skip reading them).
+        for (e, entry) in table.data.chunks(ENTRY).enumerate() {
+            let front = front_columns(e % TABLE_NUS);
+            for row in entry.chunks(SLOPE_NODES) {
+                assert!(row[front..].iter().all(|v| *v == row[front - 1]), "{row:?}");
+            }
+        }
         // Every entry is finite and within the bound.
         assert!(
             table
@@ -245,7 +288,7 @@ mod tests {
                 .iter()
                 .all(|v| v.is_finite() && v.abs() <= MAX_LOG_RATIO as f32)
         );
-        let c = table.lookup(DVec2::new(f64::NAN, 1.0), f64::NAN, f64::NAN);
+        let c = table.lookup(DVec2::new(f64::NAN, 1.0), f64::NAN, f64::NAN, (0, 99));
         assert!(c.log_ratio.iter().flatten().all(|v| v.is_finite()));
     }
 }

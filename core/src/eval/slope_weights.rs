@@ -15,10 +15,12 @@ use crate::eval::shading::SlopeShading;
 use crate::material::color_terms::Affine;
 use crate::microfacet::brdf::half_vector_posterior;
 use crate::microfacet::effective_height::HeightMoments;
-use crate::microfacet::slope_masking::{JointMasking, SLOPE_NODES, SlopeMasking, profile_at};
+use crate::microfacet::slope_masking::{
+    JointMasking, SLOPE_NODES, SlopeMasking, height_rows, profile_at, slope_node,
+};
 use crate::microfacet::slopes::{SlopeCov, slope_of};
 use crate::microfacet::visible_slopes::visible_slope_nodes;
-use glam::{DVec2, DVec3};
+use glam::{DMat3, DVec2, DVec3};
 
 /// Probabilists' Gauss–Hermite rule of 5 points, `E[f(Z)]` for `Z ~ N(0, 1)`: exact for
 /// polynomials to degree 9. `r(h, z)` is smooth in h on D_h's scale, so 5 points carry it.
@@ -55,6 +57,21 @@ pub struct SlopeHeights {
     pub mean: f64,
     /// Its standard deviation.
     pub std: f64,
+}
+
+/// The table rows [`SlopeWeights::heights`] reads for D_h of moments `hm` (both of them): its
+/// outermost Gauss–Hermite nodes.
+pub fn height_span(hm: [HeightMoments; 2]) -> (usize, usize) {
+    let reach = HERMITE5[4].0;
+    let lo = hm
+        .iter()
+        .map(|h| h.mean - reach * h.std)
+        .fold(f64::INFINITY, f64::min);
+    let hi = hm
+        .iter()
+        .map(|h| h.mean + reach * h.std)
+        .fold(f64::NEG_INFINITY, f64::max);
+    height_rows(lo, hi)
 }
 
 impl SlopeWeights {
@@ -101,8 +118,10 @@ impl SlopeWeights {
     /// The factor of the sun's specular lobe: the lobe's facets (slopes near the posterior mean
     /// `s*` of [`crate::microfacet::brdf::lobe_posterior`], where the facet slopes meet the base
     /// lobe around the half vector) are seen with the lit heights' mass at s*, against the visible
-    /// slopes' mean of it, `c(s*)·E[u⁺]/E[u⁺c]` on the rule of order `points` (`c` = `profile`).
-    /// 1 where ωo or ωi is below the horizon or no half vector exists.
+    /// slopes' mean of it, `c(s*)·E[u⁺]/E[u⁺c]` (`c` = `profile`). The visible mean comes from the
+    /// slope buckets' weights `w` ([`Evaluator::visible_shading_buckets`]): c is linear between
+    /// the slope nodes, so `Σ_j c_j w_j` is its sum over the visible nodes exactly. 1 where ωo or
+    /// ωi is below the horizon or no half vector exists.
     #[allow(clippy::too_many_arguments)]
     pub fn lobe_factor(
         &self,
@@ -112,16 +131,13 @@ impl SlopeWeights {
         wo: DVec3,
         wi: DVec3,
         sigma_lobe: f64,
-        points: usize,
+        w: &[f64; SLOPE_NODES],
     ) -> f64 {
         let Some((post, _)) = half_vector_posterior(mean, sigma, wo, wi, sigma_lobe) else {
             return 1.0;
         };
-        let (mut plain, mut weighted) = (0.0, 0.0);
-        visible_slope_nodes(mean, sigma, wo, points, |n, w| {
-            plain += w;
-            weighted += w * self.at(profile, slope_of(n));
-        });
+        let plain: f64 = w.iter().sum();
+        let weighted: f64 = w.iter().zip(profile).map(|(w, c)| w * c).sum();
         if weighted > 0.0 {
             self.at(profile, post) * plain / weighted
         } else {
@@ -226,16 +242,52 @@ pub(super) fn joint_inputs(
 }
 
 impl Evaluator {
-    /// The masking of a footprint of slopes N(mean, Σ) seen from `wo` (world): `None` under
-    /// Smith's masking (`filtering.slope_masking`), for drivers other than the noise (an image's
-    /// process is not a sum of sinusoids, [`Evaluator::slope_masking`] is `None`), at the normal
-    /// (no azimuth) and when no slope is unresolved along the view.
+    /// [`Evaluator::visible_shading_sums`] split over the slope nodes of `weights` (slope along
+    /// the view in the unresolved deviations, [`SlopeWeights::coordinate`]): each visible node
+    /// goes to the two slope nodes around it with linear (hat) weights, so that a quantity linear
+    /// between the slope nodes, summed per node against these, is its exact sum over the visible
+    /// nodes ([`crate::eval::slope_weights::joint_inputs`]). Unnormalised, with each bucket's
+    /// weight.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn visible_shading_buckets(
+        &self,
+        mean: DVec2,
+        sigma: &SlopeCov,
+        wo: DVec3,
+        wi: DVec3,
+        frame: &DMat3,
+        points: usize,
+        weights: &SlopeWeights,
+    ) -> [(SlopeShading, f64); SLOPE_NODES] {
+        let mut out = [(SlopeShading::default(), 0.0); SLOPE_NODES];
+        visible_slope_nodes(mean, sigma, wo, points, |n, w| {
+            let z = weights.coordinate(slope_of(n));
+            let x = (if z.is_nan() { 0.0 } else { z } - slope_node(0))
+                .clamp(0.0, (SLOPE_NODES - 1) as f64);
+            let j = (x as usize).min(SLOPE_NODES - 2);
+            let f = x - j as f64;
+            let p = self.point_shading(n, wi, frame);
+            for (k, wk) in [(j, w * (1.0 - f)), (j + 1, w * f)] {
+                out[k].0.add(&p, wk);
+                out[k].1 += wk;
+            }
+        });
+        out
+    }
+
+    /// The masking of a footprint of slopes N(mean, Σ) seen from `wo` (world), for
+    /// [`SlopeWeights::heights`] of the visible heights' moments `heights` (the sun's and the
+    /// environment's D_h: the table rows their nodes read): `None` under Smith's masking
+    /// (`filtering.slope_masking`), for drivers other than the noise (an image's process is not a
+    /// sum of sinusoids, [`Evaluator::slope_masking`] is `None`), at the normal (no azimuth) and
+    /// when no slope is unresolved along the view.
     pub(crate) fn slope_weights(
         &self,
         footprint: Footprint,
         mean: DVec2,
         sigma: &SlopeCov,
         wo: DVec3,
+        heights: [HeightMoments; 2],
     ) -> Option<SlopeWeights> {
         if self.material.filtering.slope_masking != SlopeMasking::Conditioned {
             return None;
@@ -258,7 +310,7 @@ impl Evaluator {
             dir,
             mean: m,
             sd,
-            joint: table.lookup(dir, scale, nu),
+            joint: table.lookup(dir, scale, nu, height_span(heights)),
         })
     }
 }
@@ -286,7 +338,15 @@ mod tests {
         };
         let wo = direction(1.3, 0.2);
         let wi = direction(0.9, 2.0);
-        let k = w.lobe_factor(&profile, DVec2::new(0.05, 0.0), &sigma, wo, wi, 0.1, 8);
+        let k = w.lobe_factor(
+            &profile,
+            DVec2::new(0.05, 0.0),
+            &sigma,
+            wo,
+            wi,
+            0.1,
+            &[0.3; 9],
+        );
         assert!((k - 1.0).abs() < 1e-12, "{k}");
         assert_eq!(w.at(&profile, DVec2::new(0.4, -0.2)), 0.7);
         // Smith's masking (r ≡ 1): every slope node sees D_h itself.
@@ -297,6 +357,55 @@ mod tests {
         for h in w.heights(hm) {
             assert!((h.mass - 1.0).abs() < 1e-12);
             assert!((h.mean - hm.mean).abs() < 1e-12 && (h.std - hm.std).abs() < 1e-12);
+        }
+    }
+
+    /// D_h at L = 1 (sun and environment alike).
+    const HM: [HeightMoments; 2] = [HeightMoments {
+        mean: 0.56,
+        std: 0.83,
+    }; 2];
+
+    /// The slope buckets carry any profile linear between the slope nodes exactly: `Σ_j c_j W_j`
+    /// is its sum over the visible nodes (what the lobe factor's visible mean uses).
+    #[test]
+    fn the_buckets_sum_a_profile_over_the_visible_nodes() {
+        let p = Evaluator::new(&preset("default")).expect("prepared");
+        let mut rng = 11u64;
+        let mut u = || crate::math::random::splitmix(&mut rng);
+        for _ in 0..50 {
+            let sigma = SlopeCov {
+                xx: 0.01 + 0.3 * u(),
+                xy: 0.02 * (u() - 0.5),
+                yy: 0.01 + 0.3 * u(),
+            };
+            let mean = DVec2::new(0.2 * (u() - 0.5), 0.2 * (u() - 0.5));
+            let wo = direction(1.5 * u(), 6.3 * u());
+            let w = SlopeWeights {
+                dir: DVec2::from_angle(6.3 * u()),
+                mean: 0.1 * (u() - 0.5),
+                sd: 0.05 + 0.4 * u(),
+                joint: JointMasking::none(),
+            };
+            let profile: [f64; SLOPE_NODES] = std::array::from_fn(|_| u());
+            let buckets = p.visible_shading_buckets(
+                mean,
+                &sigma,
+                wo,
+                DVec3::Z,
+                &glam::DMat3::IDENTITY,
+                8,
+                &w,
+            );
+            let by_buckets: f64 = (0..SLOPE_NODES).map(|j| profile[j] * buckets[j].1).sum();
+            let mut by_nodes = 0.0;
+            visible_slope_nodes(mean, &sigma, wo, 8, |n, wt| {
+                by_nodes += wt * w.at(&profile, slope_of(n));
+            });
+            assert!(
+                (by_buckets - by_nodes).abs() <= 1e-12 * by_nodes.abs().max(1e-300),
+                "{by_buckets} against {by_nodes}"
+            );
         }
     }
 
@@ -312,7 +421,7 @@ mod tests {
         };
         let wo = direction(1.3, 0.0);
         let fp = Footprint::isotropic(100.0);
-        assert!(p.slope_weights(fp, DVec2::ZERO, &sigma, wo).is_none());
+        assert!(p.slope_weights(fp, DVec2::ZERO, &sigma, wo, HM).is_none());
         let mut m = preset("cobblestones");
         m.filtering.slope_masking = SlopeMasking::Conditioned;
         let (_, img, _) = crate::driver::test_images::all().remove(0);
@@ -320,7 +429,7 @@ mod tests {
         let image = crate::driver::image::ImageDriver::new(side, side, &img).expect("image");
         let p =
             Evaluator::with_image(&m, Some(std::sync::Arc::new(image)), None).expect("prepared");
-        assert!(p.slope_weights(fp, DVec2::ZERO, &sigma, wo).is_none());
+        assert!(p.slope_weights(fp, DVec2::ZERO, &sigma, wo, HM).is_none());
         // A point footprint resolves every wave: no unresolved slopes, nothing to condition.
         let mut m = preset("default");
         m.filtering.slope_masking = SlopeMasking::Conditioned;
@@ -331,10 +440,10 @@ mod tests {
             yy: 0.0,
         };
         assert!(
-            p.slope_weights(Footprint::point(), DVec2::ZERO, &none, wo)
+            p.slope_weights(Footprint::point(), DVec2::ZERO, &none, wo, HM)
                 .is_none()
         );
-        assert!(p.slope_weights(fp, DVec2::ZERO, &sigma, wo).is_some());
+        assert!(p.slope_weights(fp, DVec2::ZERO, &sigma, wo, HM).is_some());
     }
 
     #[test]

@@ -300,13 +300,29 @@ impl JointMasking {
     /// `ln r(h, z_j)` at height `h` (σ_h units), linear between the height nodes and clamped to
     /// the end nodes (NaN reads height 0).
     pub fn log_ratio_at(&self, h: f64, j: usize) -> f64 {
-        let h = if h.is_nan() { 0.0 } else { h };
-        let x = (h - height_node(0)).clamp(0.0, (HEIGHT_NODES - 1) as f64);
-        let i = (x as usize).min(HEIGHT_NODES - 2);
-        let f = x - i as f64;
+        let (i, f) = height_cell(h);
         self.log_ratio[i][j] * (1.0 - f) + self.log_ratio[i + 1][j] * f
     }
 }
+
+/// The height nodes `i, i + 1` around height `h` (σ_h units; NaN reads 0) and the weight of
+/// `i + 1`, clamped to the end nodes.
+pub fn height_cell(h: f64) -> (usize, f64) {
+    let h = if h.is_nan() { 0.0 } else { h };
+    let x = (h - height_node(0)).clamp(0.0, (HEIGHT_NODES - 1) as f64);
+    let i = (x as usize).min(HEIGHT_NODES - 2);
+    (i, x - i as f64)
+}
+
+/// The height nodes that [`JointMasking::log_ratio_at`] reads for heights in `[lo, hi]`: rows
+/// `first..=last`.
+pub fn height_rows(lo: f64, hi: f64) -> (usize, usize) {
+    let (a, _) = height_cell(lo.min(hi));
+    let (b, _) = height_cell(lo.max(hi));
+    (a, b + 1)
+}
+
+impl JointMasking {}
 
 /// [`JointMasking`] of a ray of slope `nu` (in σ_t) on a grid built for rays at most as grazing.
 /// Edge cases as [`conditioned_masking`]: `ν ≥ 8`, `ν ≤ 0` or NaN give Smith's (`r ≡ 1`; there

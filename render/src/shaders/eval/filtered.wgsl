@@ -44,7 +44,7 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
     var sun_color: Affine;
     var env_color: Affine;
     var shading: SlopeShading;
-    let weights = slope_weights(fp, s_mean, cov, wo_w);
+    let weights = slope_weights(fp, s_mean, cov, wo_w, hm, hmo);
     if (!weights.on) {
         sun_color = affine(color_of_distribution(d.x + d.y * hm.mean, d.y * hm.std_dev, ms.total, vec2<f32>(hm.mean, hm.std_dev), d.y * d.y));
         env_color = sun_color;
@@ -66,7 +66,7 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
         env_color = joint.env;
         shading = joint.shading;
 //#if specular|measured
-        spec = spec * lobe_factor(weights, sun_h.mass, s_mean, cov, wo_w, wi_w, params.roughness, params.slope_rule_offset, params.slope_points);
+        spec = spec * lobe_factor(weights, sun_h.mass, s_mean, cov, wo_w, wi_w, params.roughness);
 //#endif
     }
     // The density ratio scales only the sun's specular term: skipped where it changes nothing.

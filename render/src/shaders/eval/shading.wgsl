@@ -280,13 +280,12 @@ fn visible_shading_buckets(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: v
             if (c != c) {
                 c = 0.0;
             }
+            // The hat weights as tents over the slope nodes, the buckets indexed by the loop
+            // counter alone (see slope_masking_lookup).
             let x = clamp(c + 4.0, 0.0, f32(SLOPE_NODES - 1u));
-            let j0 = min(u32(x), SLOPE_NODES - 2u);
-            let f = x - f32(j0);
             let p = point_shading(n, wi);
-            for (var e = 0u; e < 2u; e = e + 1u) {
-                let j = j0 + e;
-                let wj = wt * select(1.0 - f, f, e == 1u);
+            for (var j = 0u; j < SLOPE_NODES; j = j + 1u) {
+                let wj = wt * max(1.0 - abs(x - f32(j)), 0.0);
                 bucket_cos[j] = bucket_cos[j] + wj * p.cos;
                 bucket_cs_cos[j] = bucket_cs_cos[j] + wj * p.cs_cos;
                 bucket_env[j] = bucket_env[j] + wj * p.env;

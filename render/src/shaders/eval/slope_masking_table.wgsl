@@ -6,8 +6,8 @@
 
 //#if relief
 // SlopeMaskingTable::lookup: multilinear over the azimuth (periodic over π), ln r and ln ν,
-// clamped at the ends, into joint_masking.
-fn slope_masking_lookup(dir: vec2<f32>, r: f32, nu: f32) {
+// clamped at the ends, into joint_masking at the height rows rows.x..=rows.y (the rest stay 0).
+fn slope_masking_lookup(dir: vec2<f32>, r: f32, nu: f32, rows: vec2<u32>) {
     let base = params.cm_offset;
     let r0 = datum(base);
     let level_step = datum(base + 1u);
@@ -35,6 +35,8 @@ fn slope_masking_lookup(dir: vec2<f32>, r: f32, nu: f32) {
     let fl = lv - f32(l0);
     let n0 = min(u32(nv), TABLE_NUS - 2u);
     let fn_ = nv - f32(n0);
+    // Every index into joint_masking depends on loop counters alone (the same in every lane):
+    // llvmpipe reads and writes a private array at a lane-varying index one lane at a time.
     for (var j = 0u; j < TABLE_ENTRY; j = j + 1u) {
         joint_masking[j] = 0.0;
     }
@@ -45,13 +47,26 @@ fn slope_masking_lookup(dir: vec2<f32>, r: f32, nu: f32) {
         let w = select(1.0 - fa, fa, (k & 1u) != 0u)
             * select(1.0 - fl, fl, ((k >> 1u) & 1u) != 0u)
             * select(1.0 - fn_, fn_, ((k >> 2u) & 1u) != 0u);
-        if (w == 0.0) {
-            continue;
-        }
         let e = base + 2u + ((a * TABLE_LEVELS + l) * TABLE_NUS + n) * TABLE_ENTRY;
-        for (var j = 0u; j < TABLE_ENTRY; j = j + 1u) {
-            joint_masking[j] = joint_masking[j] + w * datum(e + j);
+        // Only the front slopes of the rows asked for are read: the back faces hold the last
+        // front value.
+        let front = front_columns(n);
+        for (var row = 0u; row < HEIGHT_NODES; row = row + 1u) {
+            let on = w != 0.0 && row >= rows.x && row <= rows.y;
+            var v = 0.0;
+            for (var j = 0u; j < SLOPE_NODES; j = j + 1u) {
+                if (on && j < front) {
+                    v = datum(e + row * SLOPE_NODES + j);
+                }
+                joint_masking[row * SLOPE_NODES + j] = joint_masking[row * SLOPE_NODES + j] + w * v;
+            }
         }
     }
+}
+
+// front_columns: the slope columns of ν node n that are front faces, z_j = j − 4 < ν_n.
+fn front_columns(n: u32) -> u32 {
+    let nu_n = TABLE_NU_MIN * pow(TABLE_NU_RATIO, f32(n));
+    return clamp(u32(ceil(nu_n + 4.0)), 1u, SLOPE_NODES);
 }
 //#endif

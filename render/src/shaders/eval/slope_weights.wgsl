@@ -25,10 +25,18 @@ fn slope_weights_at(w: SlopeWeights, profile: SlopeProfile, s: vec2<f32>) -> f32
     return profile_at(profile, slope_weights_coordinate(w, s));
 }
 
+// height_span: the table rows slope_heights reads for the sun's and the environment's D_h.
+fn height_span(a: HeightMoments, b: HeightMoments) -> vec2<u32> {
+    let reach = 2.856970013872806;
+    let lo = min(a.mean - reach * a.std_dev, b.mean - reach * b.std_dev);
+    let hi = max(a.mean + reach * a.std_dev, b.mean + reach * b.std_dev);
+    return height_rows(lo, hi);
+}
+
 // Evaluator::slope_weights: off without the material's table (Smith's masking, an image
 // driver), at the normal, or with no unresolved slope along the view; on, it looks the joint
-// masking up into joint_masking.
-fn slope_weights(fp: vec3<f32>, mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>) -> SlopeWeights {
+// masking up into joint_masking, at the rows the D_h of hm_sun and hm_env read.
+fn slope_weights(fp: vec3<f32>, mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, hm_sun: HeightMoments, hm_env: HeightMoments) -> SlopeWeights {
     var out: SlopeWeights;
     out.on = false;
     if (params.cm_on == 0u) {
@@ -51,7 +59,7 @@ fn slope_weights(fp: vec3<f32>, mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>) 
     out.dir = dir;
     out.mean = m;
     out.sd = sd;
-    slope_masking_lookup(dir, scale, nu);
+    slope_masking_lookup(dir, scale, nu, height_span(hm_sun, hm_env));
     return out;
 }
 
@@ -62,17 +70,32 @@ struct SlopeHeights {
     std_dev: SlopeProfile,
 }
 
-// SlopeWeights::heights: 5-point Gauss–Hermite on D_h's Gaussian of moments hm.
+// SlopeWeights::heights: 5-point Gauss–Hermite on D_h's Gaussian of moments hm. ln r at each
+// node is log_ratio_at's linear interpolation written as tents over the height rows, so that
+// joint_masking is indexed by loop counters alone (see slope_masking_lookup).
 fn slope_heights(hm: HeightMoments) -> SlopeHeights {
     let gx = array<f32, 5>(-2.856970013872806, -1.355626179974266, 0.0, 1.355626179974266, 2.856970013872806);
     let gw = array<f32, 5>(0.01125741132772069, 0.2220759220056126, 0.5333333333333333, 0.2220759220056126, 0.01125741132772069);
+    // Each node's position on the row axis (height_cell's clamped coordinate).
+    var x: array<f32, 5>;
+    for (var k = 0u; k < 5u; k = k + 1u) {
+        let c = height_cell(hm.mean + hm.std_dev * gx[k]);
+        x[k] = c.x + c.y;
+    }
     var out: SlopeHeights;
     for (var j = 0u; j < SLOPE_NODES; j = j + 1u) {
+        var lr = array<f32, 5>(0.0, 0.0, 0.0, 0.0, 0.0);
+        for (var i = 0u; i < HEIGHT_NODES; i = i + 1u) {
+            let v = joint_masking[i * SLOPE_NODES + j];
+            for (var k = 0u; k < 5u; k = k + 1u) {
+                lr[k] = lr[k] + max(1.0 - abs(x[k] - f32(i)), 0.0) * v;
+            }
+        }
         var m0 = 0.0;
         var m1 = 0.0;
         var m2 = 0.0;
         for (var k = 0u; k < 5u; k = k + 1u) {
-            let r = gw[k] * exp(log_ratio_at(hm.mean + hm.std_dev * gx[k], j));
+            let r = gw[k] * exp(lr[k]);
             m0 = m0 + r;
             m1 = m1 + r * gx[k];
             m2 = m2 + r * gx[k] * gx[k];
@@ -189,8 +212,8 @@ fn weighted_term(num: vec3<f32>, den: vec3<f32>, fnum: vec3<f32>, fden: f32, mid
 
 //#if specular|measured
 // SlopeWeights::lobe_factor: the sun's lobe × the profile at its posterior slope over the
-// profile's visible mean.
-fn lobe_factor(w: SlopeWeights, profile: SlopeProfile, mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, roughness: f32, rule_off: u32, points: u32) -> f32 {
+// profile's visible mean, from the slope buckets' weights (visible_shading_buckets).
+fn lobe_factor(w: SlopeWeights, profile: SlopeProfile, mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, roughness: f32) -> f32 {
     if (!(wo.z > 0.0 && wi.z > 0.0)) {
         return 1.0;
     }
@@ -199,18 +222,11 @@ fn lobe_factor(w: SlopeWeights, profile: SlopeProfile, mean: vec2<f32>, cov: vec
         return 1.0;
     }
     let post = lobe_posterior(mean, cov, slope_of(h), roughness);
-    let l = cholesky(cov);
     var plain = 0.0;
     var weighted = 0.0;
-    for (var i = 0u; i < points * points; i = i + 1u) {
-        let b = rule_off + 3u * i;
-        let z = vec3<f32>(datum(b), datum(b + 1u), datum(b + 2u));
-        let s = mean + vec2<f32>(l.x * z.x, l.y * z.x + l.z * z.y);
-        let wt = z.z * max(wo.z - s.x * wo.x - s.y * wo.y, 0.0);
-        if (wt > 0.0) {
-            plain = plain + wt;
-            weighted = weighted + wt * slope_weights_at(w, profile, slope_of(normal_of(s)));
-        }
+    for (var j = 0u; j < SLOPE_NODES; j = j + 1u) {
+        plain = plain + bucket_w[j];
+        weighted = weighted + bucket_w[j] * profile_node(profile, j);
     }
     if (weighted > 0.0) {
         return slope_weights_at(w, profile, post.mean) * plain / weighted;

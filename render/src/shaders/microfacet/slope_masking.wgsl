@@ -32,16 +32,29 @@ fn profile_at(profile: SlopeProfile, z: f32) -> f32 {
 // gpu_codes) nodes, height-major, written by slope_masking_lookup.
 var<private> joint_masking: array<f32, 90>;
 
-// JointMasking::log_ratio_at: ln r(h, z_j), linear between the height nodes (h in σ_h, from
-// −HEIGHT_NODE_DEPTH by 1), clamped to the end nodes; NaN reads height 0.
-fn log_ratio_at(h: f32, j: u32) -> f32 {
+// height_cell: the height nodes i, i + 1 around h (σ_h units, from −HEIGHT_NODE_DEPTH by 1; NaN
+// reads 0) and the weight of i + 1, clamped to the end nodes.
+fn height_cell(h: f32) -> vec2<f32> {
     var hh = h;
     if (hh != hh) {
         hh = 0.0;
     }
     let x = clamp(hh + HEIGHT_NODE_DEPTH, 0.0, f32(HEIGHT_NODES - 1u));
-    let i = min(u32(x), HEIGHT_NODES - 2u);
-    let f = x - f32(i);
-    return joint_masking[i * SLOPE_NODES + j] * (1.0 - f) + joint_masking[(i + 1u) * SLOPE_NODES + j] * f;
+    let i = min(floor(x), f32(HEIGHT_NODES - 2u));
+    return vec2<f32>(i, x - i);
+}
+
+// height_rows: the rows first..=last that log_ratio_at reads for heights in [lo, hi].
+fn height_rows(lo: f32, hi: f32) -> vec2<u32> {
+    let a = height_cell(min(lo, hi));
+    let b = height_cell(max(lo, hi));
+    return vec2<u32>(u32(a.x), u32(b.x) + 1u);
+}
+
+// JointMasking::log_ratio_at: ln r(h, z_j), linear between the height nodes.
+fn log_ratio_at(h: f32, j: u32) -> f32 {
+    let c = height_cell(h);
+    let i = u32(c.x);
+    return joint_masking[i * SLOPE_NODES + j] * (1.0 - c.y) + joint_masking[(i + 1u) * SLOPE_NODES + j] * c.y;
 }
 //#endif
