@@ -831,7 +831,7 @@ fn filtering(ui: &mut Ui, f: &mut Filtering) -> bool {
             ui.selectable_value(&mut sm, SlopeMasking::Conditioned, "Conditioned on slope");
         })
         .response
-        .on_hover_text("Masking of the visible slopes D_s: Smith's, where a facet's visibility depends on its height alone [HN12 Eqs. 4–6] (default), or conditioned on the facet's slope along the view (Smith's crossing rate with the surface conditioned on the start's height and slope through the noise's autocovariance; Rice, Smith 1967): facets facing the eye are seen more, those leaning to the silhouette less. Noise drivers; closes most of the grazing error with the light at the normal or on the viewer's side (snake-skin at 75°: from −9% to −0.7%), not with the light opposite (#17, docs/design.md). A table of about a second per noise");
+        .on_hover_text("Masking of the visible (height, slope) pairs: Smith's, where a facet's visibility depends on its height alone [HN12 Eqs. 4–6], or conditioned on the facet's height and slope along the view jointly (default; Smith's crossing rate with the surface conditioned on the start's height and slope through the noise's autocovariance; Rice, Smith 1967): facets facing the eye are seen more, those leaning to the silhouette less, high ones at every slope; each slope then sees its own heights, so colour and shading are summed together. Noise drivers (images keep Smith's); snake-skin at 75°: from −9% to +0.6% against the ray-traced truth (#17, docs/design.md). A table of about a second per noise");
     if sm != f.slope_masking {
         f.slope_masking = sm;
         changed = true;
