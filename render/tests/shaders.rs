@@ -155,7 +155,7 @@ const GPU_ONLY: &[(&str, &str, &str)] = &[
     ("driver/noise.wgsl", "cached_wave", "reads wave i from the uniform wave table"),
     ("driver/image.wgsl", "image_level", "reads a pyramid level's record from the data buffer"),
     ("material/preconvolved.wgsl", "texel4", "reads a table texel from the data buffer"),
-    ("eval/shading.wgsl", "bucket", "bucket j of the private bucket arrays as a SlopeShading"),
+    ("eval/slope_weights.wgsl", "bucket", "bucket j of the private bucket arrays as a SlopeShading"),
     ("microfacet/slope_masking.wgsl", "profile_node", "node j of a profile packed in a 3 × 3 matrix"),
     ("eval/shading.wgsl", "has_environment", "the parameter flag for an environment"),
     ("scene/octave_march.wgsl", "octave_count", "the waves summed: lod_prepare's count of those the footprint leaves above 1e-10"),

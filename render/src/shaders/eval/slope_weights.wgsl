@@ -63,6 +63,60 @@ fn slope_weights(fp: vec3<f32>, mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, 
     return out;
 }
 
+// The visible shading split over the slope nodes (SLOPE_NODES = 9), as
+// visible_shading_buckets leaves it: each bucket's unnormalised SlopeShading sums and weight,
+// field by field (the GLSL export round-trips neither arrays of structs nor structs of arrays).
+var<private> bucket_cos: array<f32, 9>;
+var<private> bucket_cs_cos: array<vec3<f32>, 9>;
+var<private> bucket_env: array<vec3<f32>, 9>;
+var<private> bucket_cs_env: array<vec3<f32>, 9>;
+var<private> bucket_w: array<f32, 9>;
+
+// Bucket j's sums as a SlopeShading.
+fn bucket(j: u32) -> SlopeShading {
+    return SlopeShading(bucket_cos[j], bucket_cs_cos[j], bucket_env[j], bucket_cs_env[j]);
+}
+
+// Evaluator::visible_shading_buckets: each visible node to the two slope nodes around its slope
+// along the view, with linear (hat) weights (into the bucket arrays).
+fn visible_shading_buckets(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, rule_off: u32, points: u32, weights: SlopeWeights) {
+    let l = cholesky(cov);
+    let nodes = points * points;
+    for (var j = 0u; j < SLOPE_NODES; j = j + 1u) {
+        bucket_cos[j] = 0.0;
+        bucket_cs_cos[j] = vec3<f32>(0.0);
+        bucket_env[j] = vec3<f32>(0.0);
+        bucket_cs_env[j] = vec3<f32>(0.0);
+        bucket_w[j] = 0.0;
+    }
+    for (var i = 0u; i < nodes; i = i + 1u) {
+        let b = rule_off + 3u * i;
+        let z = vec3<f32>(datum(b), datum(b + 1u), datum(b + 2u));
+        let s = mean + vec2<f32>(l.x * z.x, l.y * z.x + l.z * z.y);
+        let u = max(wo.z - s.x * wo.x - s.y * wo.y, 0.0);
+        let wt = z.z * u;
+        if (wt > 0.0) {
+            let n = normal_of(s);
+            var c = slope_weights_coordinate(weights, slope_of(n));
+            if (c != c) {
+                c = 0.0;
+            }
+            // The hat weights as tents over the slope nodes, the buckets indexed by the loop
+            // counter alone (see slope_masking_lookup).
+            let x = clamp(c + 4.0, 0.0, f32(SLOPE_NODES - 1u));
+            let p = point_shading(n, wi);
+            for (var j = 0u; j < SLOPE_NODES; j = j + 1u) {
+                let wj = wt * max(1.0 - abs(x - f32(j)), 0.0);
+                bucket_cos[j] = bucket_cos[j] + wj * p.cos;
+                bucket_cs_cos[j] = bucket_cs_cos[j] + wj * p.cs_cos;
+                bucket_env[j] = bucket_env[j] + wj * p.env;
+                bucket_cs_env[j] = bucket_cs_env[j] + wj * p.cs_env;
+                bucket_w[j] = bucket_w[j] + wj;
+            }
+        }
+    }
+}
+
 // SlopeHeights at every slope node: the mass, mean and standard deviation of D_h·r(·, z_j).
 struct SlopeHeights {
     mass: SlopeProfile,
