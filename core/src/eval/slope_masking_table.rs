@@ -50,7 +50,10 @@ pub struct SlopeMaskingTable {
 /// Tables built in this process, by their waves' shape, with the first wave vector's length they
 /// were built for (at most [`CACHE_SIZE`]; a material edited back and forth, and the tests' many
 /// evaluators of the same presets, build each once).
-static CACHE: Mutex<Vec<(Vec<u64>, Arc<SlopeMaskingTable>, f64)>> = Mutex::new(Vec::new());
+static CACHE: Mutex<Vec<CacheEntry>> = Mutex::new(Vec::new());
+
+/// A cached table: the waves' shape, the table, the first wave vector's length it was built for.
+type CacheEntry = (Vec<u64>, Arc<SlopeMaskingTable>, f64);
 
 /// Tables the process keeps ([`SlopeMaskingTable::shared`]).
 const CACHE_SIZE: usize = 16;
