@@ -1,8 +1,8 @@
-//! A noise material's table of slope-conditioned masking ([`crate::microfacet::slope_masking::conditioned_masking`], #17): the
-//! profiles over the ray's azimuth, the footprint's scale and the ray's slope ν, in f32 as the GPU
-//! reads them. Core's filtered model looks up the same values, so the views and core agree; the
-//! direct computation stays the definition of each entry (tested against the lookup between
-//! nodes).
+//! A noise material's table of slope-conditioned masking
+//! ([`crate::microfacet::slope_masking::JointMasking`], #17): `ln r` at every (height, slope) node,
+//! over the ray's azimuth, the footprint's scale and the ray's slope ν, in f32 as the GPU reads
+//! them. Core's filtered model looks up the same values, so the views and core agree; the direct
+//! computation stays the definition of each entry (tested against the lookup between nodes).
 //!
 //! Axes:
 //! - **azimuth** φ of the ray's horizontal direction, [`TABLE_AZIMUTHS`] nodes over [0, π)

@@ -14,9 +14,12 @@
 //! Eq. 5]), so `G1(h₀, t) = exp(−∫ rate dτ)`. Without the conditioning (an independent future) it is
 //! Smith's `Φ(h₀)^Λ` [HN12 Eqs. 4–6].
 //!
-//! The views keep their height-correlated G2 and D_h (the colour of the visible heights) and
-//! reweight the visible slopes D_s by `E_h₀[G1(h₀, t)]` ([`conditioned_masking`]), normalised over
-//! D_s, so the mean visibility stays Smith's and only its share among the slopes moves.
+//! The views keep their height-correlated G2 and D_h and weight the visible (height, slope) pairs
+//! by G1 relative to Smith's, `r(h₀, t)` ([`JointMasking`]): each slope sees its own heights, and
+//! the mean visibility stays Smith's, only its share among the pairs moves
+//! ([`crate::eval::slope_weights`]). [`conditioned_masking`], the height-averaged profile
+//! `E_h₀[G1(h₀, t)]`, is what session 18's views used (colour and slopes reweighted separately,
+//! which failed with the light opposite the view; docs/design.md); the measurements keep it.
 //!
 //! Units: the process is normalised to unit height and slope variance ([`LineProcess`]), so the
 //! slope is `z = t/σ_t` and the ray's slope `ν = μ/σ_t`, with `σ_t = √λ₂` the slope's standard
