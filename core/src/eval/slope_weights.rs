@@ -16,7 +16,7 @@ use crate::material::color_terms::Affine;
 use crate::microfacet::brdf::half_vector_posterior;
 use crate::microfacet::effective_height::HeightMoments;
 use crate::microfacet::slope_masking::{
-    JointMasking, SLOPE_NODES, SlopeMasking, height_rows, profile_at, slope_node,
+    JointMasking, SLOPE_NODES, SlopeMasking, height_rows, profile_at, slope_cell,
 };
 use crate::microfacet::slopes::{SlopeCov, slope_of};
 use crate::microfacet::visible_slopes::visible_slope_nodes;
@@ -261,11 +261,7 @@ impl Evaluator {
     ) -> [(SlopeShading, f64); SLOPE_NODES] {
         let mut out = [(SlopeShading::default(), 0.0); SLOPE_NODES];
         visible_slope_nodes(mean, sigma, wo, points, |n, w| {
-            let z = weights.coordinate(slope_of(n));
-            let x = (if z.is_nan() { 0.0 } else { z } - slope_node(0))
-                .clamp(0.0, (SLOPE_NODES - 1) as f64);
-            let j = (x as usize).min(SLOPE_NODES - 2);
-            let f = x - j as f64;
+            let (j, f) = slope_cell(weights.coordinate(slope_of(n)));
             let p = self.point_shading(n, wi, frame);
             for (k, wk) in [(j, w * (1.0 - f)), (j + 1, w * f)] {
                 out[k].0.add(&p, wk);

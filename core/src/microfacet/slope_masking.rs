@@ -360,11 +360,17 @@ pub fn joint_masking_on(grid: &ProcessGrid, nu: f64) -> JointMasking {
 /// Linear interpolation of a [`conditioned_masking`] profile at slope `z` (in σ_t), clamped to
 /// the end nodes; NaN gives the profile's value at 0.
 pub fn profile_at(profile: &[f64; SLOPE_NODES], z: f64) -> f64 {
-    let z = if z.is_nan() { 0.0 } else { z };
-    let x = (z + 4.0).clamp(0.0, (SLOPE_NODES - 1) as f64);
-    let i = (x as usize).min(SLOPE_NODES - 2);
-    let f = x - i as f64;
+    let (i, f) = slope_cell(z);
     profile[i] * (1.0 - f) + profile[i + 1] * f
+}
+
+/// The slope nodes `j, j + 1` around slope `z` (σ_t units; NaN reads 0) and the weight of
+/// `j + 1`, clamped to the end nodes.
+pub fn slope_cell(z: f64) -> (usize, f64) {
+    let z = if z.is_nan() { 0.0 } else { z };
+    let x = (z - slope_node(0)).clamp(0.0, (SLOPE_NODES - 1) as f64);
+    let j = (x as usize).min(SLOPE_NODES - 2);
+    (j, x - j as f64)
 }
 
 #[cfg(test)]
