@@ -61,6 +61,8 @@ mod slope_weights_measurements;
 pub(crate) mod test_materials;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod transfer_masking_measurements;
 
 pub use compiled::{CompiledColor, CompiledTransfer};
 pub use evaluator::Evaluator;
