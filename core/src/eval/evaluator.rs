@@ -9,6 +9,7 @@ use crate::driver::histogram::DriverHistogram;
 use crate::driver::image::ImageDriver;
 use crate::eval::compiled::{CompiledColor, CompiledTransfer};
 use crate::eval::slope_masking_table::SlopeMaskingTable;
+use crate::eval::transfer_masking_table::TransferMaskingTable;
 use crate::material::Material;
 use crate::material::environment::EquirectMap;
 use crate::material::measured::{ChannelWeights, MeasuredBrdf};
@@ -47,6 +48,10 @@ pub struct Evaluator {
     /// The noise's table of slope-conditioned masking, when the material asks for it
     /// (`filtering.slope_masking`, [`crate::eval::slope_masking_table`]).
     pub slope_masking: Option<Arc<SlopeMaskingTable>>,
+    /// The transfer mixture's masking conditioned on the driver's value and slope
+    /// ([`crate::eval::transfer_masking_table`]): a CPU prototype that [`Evaluator::new`] does
+    /// not build (the views do not have it yet); a measurement sets it to compare.
+    pub transfer_masking: Option<Arc<TransferMaskingTable>>,
 }
 
 impl Evaluator {
@@ -145,6 +150,7 @@ impl Evaluator {
             environment,
             measured: None,
             slope_masking,
+            transfer_masking: None,
         })
     }
 

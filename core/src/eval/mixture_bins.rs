@@ -24,6 +24,7 @@
 use crate::driver::conditional_slopes::ImageSlopes;
 use crate::eval::query::FootprintStats;
 use crate::eval::shading::{SlopeShading, specular_tint};
+use crate::eval::transfer_masking_table::TransferRays;
 use crate::eval::{Evaluator, FootprintQuery};
 use crate::material::transfer::TransferFunction;
 use crate::math::special::norm_quantile;
@@ -143,16 +144,23 @@ impl Evaluator {
         let weights = self.channel_weights();
         let sun = m.lighting.sun * sun_visible;
         let points = bin_slope_points(m.filtering.slope_points, m.terms.slope.is_some());
+        let conditioned = self
+            .transfer_masking
+            .as_ref()
+            .map(|t| TransferRays::new(t, d, (wo, wi), sun_lit, sigma_h, m.filtering.correlation));
         let (mut above_o, mut above) = (0.0, 0.0);
         let (mut num, mut den) = ([0.0f64; 3], 0.0f64);
         for &(lo, hi, bin) in bins.iter().rev() {
             let mean = d.mean_gradient * (sigma_h * bin.mean_deriv);
             let cov = d.gradient_cov.scaled(sigma_h * bin.rms_deriv);
             let ms = G2::from_directions(wo, wi, &cov, m.filtering.correlation);
-            let w1 = bin_masking(lo, hi, ms.lambda_o, above_o);
-            let w2 = bin_masking(lo, hi, ms.total, above);
+            let mut w1 = bin_masking(lo, hi, ms.lambda_o, above_o);
+            let mut w2 = bin_masking(lo, hi, ms.total, above);
             above_o += bin_exponent(lo, hi, ms.lambda_o);
             above += bin_exponent(lo, hi, ms.total);
+            if let Some(c) = &conditioned {
+                (w1, w2) = c.bin_weights(lo, hi, bin.mean_deriv, (w1, w2));
+            }
             let (s, s_o): (SlopeShading, f64) =
                 self.visible_shading_sums(mean, &cov, cfg.wo, cfg.wi, frame, points);
             den += w1 * s_o;

@@ -46,6 +46,7 @@ pub mod sampling_plan;
 pub mod shading;
 pub mod slope_masking_table;
 pub mod slope_weights;
+pub mod transfer_masking_table;
 pub mod truth_prediction;
 pub mod view_independent;
 
@@ -63,6 +64,8 @@ pub(crate) mod test_materials;
 mod tests;
 #[cfg(test)]
 mod transfer_masking_measurements;
+#[cfg(test)]
+mod transfer_masking_prototype;
 
 pub use compiled::{CompiledColor, CompiledTransfer};
 pub use evaluator::Evaluator;

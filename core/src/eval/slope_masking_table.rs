@@ -175,15 +175,8 @@ impl SlopeMaskingTable {
         } else {
             (TABLE_LEVELS - 1) as f64
         };
-        let nv = if nu > 0.0 && nu.is_finite() {
-            ((nu / NU_MIN).ln() / NU_RATIO.ln()).clamp(0.0, (TABLE_NUS - 1) as f64)
-        } else if nu > 0.0 {
-            (TABLE_NUS - 1) as f64
-        } else {
-            0.0
-        };
         let (l0, fl) = split(lv, TABLE_LEVELS);
-        let (n0, fn_) = split(nv, TABLE_NUS);
+        let (n0, fn_) = nu_coordinate(nu);
         let (first, last) = (rows.0.min(HEIGHT_NODES - 1), rows.1.min(HEIGHT_NODES - 1));
         let span = first * SLOPE_NODES..(last + 1) * SLOPE_NODES;
         let mut acc = [0.0f64; ENTRY];
@@ -226,7 +219,7 @@ pub fn front_columns(n: usize) -> usize {
 }
 
 /// The two azimuth nodes around `dir` and the weight of the second (periodic over π).
-fn azimuth_coordinate(dir: DVec2) -> (usize, usize, f64) {
+pub(crate) fn azimuth_coordinate(dir: DVec2) -> (usize, usize, f64) {
     let phi = dir.y.atan2(dir.x).rem_euclid(PI);
     let x = if phi.is_finite() {
         phi / PI * TABLE_AZIMUTHS as f64
@@ -236,6 +229,19 @@ fn azimuth_coordinate(dir: DVec2) -> (usize, usize, f64) {
     let i = (x.floor() as usize).min(TABLE_AZIMUTHS - 1);
     let f = (x - i as f64).clamp(0.0, 1.0);
     (i, (i + 1) % TABLE_AZIMUTHS, f)
+}
+
+/// The ν nodes `n, n + 1` around `nu` and the weight of `n + 1`, linear in ln ν and clamped to
+/// the end nodes (NaN and ν ≤ 0 read the first node, +∞ the last).
+pub(crate) fn nu_coordinate(nu: f64) -> (usize, f64) {
+    let nv = if nu > 0.0 && nu.is_finite() {
+        ((nu / NU_MIN).ln() / NU_RATIO.ln()).clamp(0.0, (TABLE_NUS - 1) as f64)
+    } else if nu > 0.0 {
+        (TABLE_NUS - 1) as f64
+    } else {
+        0.0
+    };
+    split(nv, TABLE_NUS)
 }
 
 /// A clamped coordinate in `[0, n − 1]` as the lower node (at most n − 2) and the fraction.

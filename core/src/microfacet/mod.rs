@@ -17,6 +17,7 @@
 //! | a(h) = ā + a_s·s(h) | [`attribute`] | [HN12 Eq. 17] |
 
 pub mod attribute;
+pub mod barrier_masking;
 pub mod brdf;
 pub mod effective_height;
 pub mod height_mixture;

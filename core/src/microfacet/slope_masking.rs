@@ -190,6 +190,17 @@ impl ProcessGrid {
         }
         Self { dt, values, memory }
     }
+
+    /// The τ step.
+    pub fn step(&self) -> f64 {
+        self.dt
+    }
+
+    /// `(R̂, R̂′, R̂″)` at the midpoints of the steps for as long as the process remembers the
+    /// start (past them the rate is Smith's, unconditioned).
+    pub fn remembered(&self) -> &[(f64, f64, f64)] {
+        &self.values[..self.memory]
+    }
 }
 
 /// [`conditioned_masking`] on a grid built for rays at most as grazing as `nu`.
@@ -248,23 +259,11 @@ fn log_g1(grid: &[(f64, f64, f64)], dt: f64, h0: f64, t: f64, nu: f64) -> f64 {
         if ray > TOP {
             return -integral;
         }
-        let mh = r * h0 - r1 * t;
-        let mp = r1 * h0 - r2 * t;
-        let vh = (1.0 - r * r - r1 * r1).max(1e-12);
-        let vp = 1.0 - r1 * r1 - r2 * r2;
-        let c = -r * r1 - r1 * r2;
-        let sh = vh.sqrt();
-        let z = (ray - mh) / sh;
-        let below = norm_cdf(z);
-        if below < 1e-300 {
+        let Some(rate) = conditioned_rate((r, r1, r2), (h0, t), (ray, nu)) else {
             // The ray is certainly below the conditioned surface: it is crossed.
             return f64::NEG_INFINITY;
-        }
-        let m2 = mp + c / vh * (ray - mh) - nu;
-        let s2 = (vp - c * c / vh).max(1e-12).sqrt();
-        let q = m2 / s2;
-        let up = s2 * norm_pdf(q) + m2 * norm_cdf(q);
-        integral += up * norm_pdf(z) / sh / below * dt;
+        };
+        integral += rate * dt;
         if integral > MAX_LOG {
             return f64::NEG_INFINITY;
         }
@@ -274,6 +273,35 @@ fn log_g1(grid: &[(f64, f64, f64)], dt: f64, h0: f64, t: f64, nu: f64) -> f64 {
     let excess = norm_pdf(nu) - nu * norm_cdf(-nu);
     integral -= excess.max(0.0) / nu * log_norm_cdf(ray);
     -integral
+}
+
+/// Rice's crossing rate with Smith's "below so far", for a normalised process conditioned on its
+/// start: `E[(h′ − ν)⁺ | h = r]·p(h = r)/P(h < r)` at a lag where the autocovariance is
+/// `(R̂, R̂′, R̂″)`, the start `(h₀, t)`, and the level `r` crossed with slope `ν` (the ray's
+/// height and slope, or a curved barrier's, [`crate::microfacet::barrier_masking`]). The pair
+/// `(h, h′)` at the lag is Gaussian with mean `(R̂h₀ − R̂′t, R̂′h₀ − R̂″t)` and the Schur complement as
+/// covariance (module docs). `None` where the level is certainly below the surface (crossed).
+pub fn conditioned_rate(
+    (r, r1, r2): (f64, f64, f64),
+    (h0, t): (f64, f64),
+    (level, slope): (f64, f64),
+) -> Option<f64> {
+    let mh = r * h0 - r1 * t;
+    let mp = r1 * h0 - r2 * t;
+    let vh = (1.0 - r * r - r1 * r1).max(1e-12);
+    let vp = 1.0 - r1 * r1 - r2 * r2;
+    let c = -r * r1 - r1 * r2;
+    let sh = vh.sqrt();
+    let z = (level - mh) / sh;
+    let below = norm_cdf(z);
+    if below < 1e-300 {
+        return None;
+    }
+    let m2 = mp + c / vh * (level - mh) - slope;
+    let s2 = (vp - c * c / vh).max(1e-12).sqrt();
+    let q = m2 / s2;
+    let up = s2 * norm_pdf(q) + m2 * norm_cdf(q);
+    Some(up * norm_pdf(z) / sh / below)
 }
 
 /// Bound on `|ln r|` of [`JointMasking`]: where the conditioned and Smith's masking differ by more

@@ -1,0 +1,502 @@
+//! A transfer-curve material's table of masking conditioned on the driver's value and slope
+//! ([`crate::microfacet::barrier_masking`], #17), and the visibility of the transfer mixture's
+//! bins it gives ([`bin_visibility`]).
+//!
+//! Entry: `ln G1(x_i, t_j)` at [`VALUE_NODES`] driver values `x_i` ([`value_node`], in the
+//! driver's global σ) × [`SLOPE_NODES`] driver slopes along the ray `t_j` ([`slope_node`], in the
+//! driver's global slope σ along the ray's azimuth), clamped to `[−MAX_LOG_G1, 0]`; back faces
+//! hold the last front value (the clamped cosine and the projected area take them out).
+//! Axes as [`crate::eval::slope_masking_table`]'s, without its footprint levels: the ray's
+//! azimuth ([`TABLE_AZIMUTHS`] over [0, π)) and `ν = μ/(σ_h σ_t)` ([`TABLE_NUS`] nodes, linear in
+//! ln ν). The process is the driver's whole (far field): the barrier is the curve at the
+//! driver's absolute value, which a footprint's unresolved part alone does not know, so the
+//! views blend toward Smith's as the footprint resolves the driver ([`far_weight`]).
+
+use crate::driver::noise::SumOfSines;
+use crate::eval::slope_masking_table::{
+    NU_MIN, NU_RATIO, TABLE_AZIMUTHS, TABLE_NUS, azimuth_coordinate, nu_coordinate,
+};
+use crate::material::transfer::TransferFunction;
+use crate::math::gaussian::cholesky;
+use crate::math::quadrature::gauss_hermite_normal;
+use crate::microfacet::barrier_masking::{TransferBarrier, barrier_log_g1};
+use crate::microfacet::slope_masking::{LineProcess, ProcessGrid};
+use glam::DVec2;
+use rayon::prelude::*;
+use std::f64::consts::{PI, TAU};
+use std::sync::{Arc, Mutex};
+
+/// Driver values of an entry: `−4 + VALUE_STEP·i` (σ units).
+pub const VALUE_NODES: usize = 32;
+/// Step of the value nodes (σ units): 0.5 smeared a tread's masking across the riser next to
+/// it (terraces, 16% off between nodes; docs/design.md).
+pub const VALUE_STEP: f64 = 0.25;
+/// Driver slopes of an entry: `−4 + SLOPE_STEP·j` (σ units).
+pub const SLOPE_NODES: usize = 17;
+/// Step of the slope nodes (σ units): over a tread `ln G1` falls ever faster as the driver rises
+/// toward the ray, and a chord across 1σ came out several percent dark (terraces).
+pub const SLOPE_STEP: f64 = 0.5;
+/// f32 values per entry, value-major.
+pub const TRANSFER_ENTRY: usize = VALUE_NODES * SLOPE_NODES;
+
+/// Driver slope of node `j` (σ units along the ray).
+pub fn slope_node(j: usize) -> f64 {
+    -4.0 + SLOPE_STEP * j as f64
+}
+
+/// The slope nodes `j, j + 1` around `t` and the weight of `j + 1`, clamped (NaN reads 0).
+pub fn slope_cell(t: f64) -> (usize, f64) {
+    node_cell(t, slope_node(0), SLOPE_STEP, SLOPE_NODES)
+}
+/// Clamp of `−ln G1` (a start masked beyond e⁻³⁰ is as good as hidden).
+pub const MAX_LOG_G1: f64 = 30.0;
+
+/// Driver value of node `i` (global σ units).
+pub fn value_node(i: usize) -> f64 {
+    -4.0 + VALUE_STEP * i as f64
+}
+
+/// The value nodes `i, i + 1` around `x` and the weight of `i + 1`, clamped (NaN reads 0).
+pub fn value_cell(x: f64) -> (usize, f64) {
+    node_cell(x, value_node(0), VALUE_STEP, VALUE_NODES)
+}
+
+/// The nodes `i, i + 1` of an evenly spaced axis (`first + step·i`, n nodes) around `x` and the
+/// weight of `i + 1`, clamped to the ends (NaN reads 0).
+fn node_cell(x: f64, first: f64, step: f64, n: usize) -> (usize, f64) {
+    let x = if x.is_nan() { 0.0 } else { x };
+    let u = ((x - first) / step).clamp(0.0, (n - 1) as f64);
+    let i = (u as usize).min(n - 2);
+    (i, u - i as f64)
+}
+
+/// The table (module docs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TransferMaskingTable {
+    /// The driver's global standard deviation.
+    pub sigma_f: f64,
+    /// The driver's global gradient covariance `(xx, xy, yy)`.
+    pub gradient: [f64; 3],
+    /// `TRANSFER_ENTRY` values per (azimuth, ν), ν fastest.
+    pub data: Vec<f32>,
+}
+
+static CACHE: Mutex<Vec<(Vec<u64>, Arc<TransferMaskingTable>)>> = Mutex::new(Vec::new());
+const CACHE_SIZE: usize = 8;
+
+impl TransferMaskingTable {
+    /// [`TransferMaskingTable::new`] through a process-wide cache keyed by the waves and the
+    /// curve, exactly (the tests' many evaluators of the same presets build it once).
+    pub fn shared(noise: &SumOfSines, transfer: &TransferFunction) -> Option<Arc<Self>> {
+        let mut key: Vec<u64> = noise
+            .waves
+            .iter()
+            .flat_map(|w| [w.k.x.to_bits(), w.k.y.to_bits(), w.amplitude.to_bits()])
+            .collect();
+        if let TransferFunction::Curve(c) = transfer {
+            key.extend(
+                c.points
+                    .iter()
+                    .flat_map(|p| [p[0].to_bits(), p[1].to_bits()]),
+            );
+            key.push(c.interpolation as u64);
+        }
+        let lock = || {
+            CACHE
+                .lock()
+                .unwrap_or_else(std::sync::PoisonError::into_inner)
+        };
+        if let Some((_, t)) = lock().iter().find(|(k, _)| *k == key) {
+            return Some(t.clone());
+        }
+        let table = Arc::new(Self::new(noise, transfer)?);
+        let mut cache = lock();
+        if cache.len() >= CACHE_SIZE {
+            cache.remove(0);
+        }
+        cache.push((key, table.clone()));
+        Some(table)
+    }
+
+    /// Tabulate (in parallel over azimuths). `None` without waves of any variance.
+    pub fn new(noise: &SumOfSines, transfer: &TransferFunction) -> Option<Self> {
+        let var: f64 = noise
+            .waves
+            .iter()
+            .map(|w| 0.5 * w.amplitude * w.amplitude)
+            .sum();
+        if !(var > 0.0 && var.is_finite()) {
+            return None;
+        }
+        let mut gradient = [0.0; 3];
+        for w in &noise.waves {
+            let (c, k) = (0.5 * w.amplitude * w.amplitude, TAU * w.k);
+            gradient[0] += c * k.x * k.x;
+            gradient[1] += c * k.x * k.y;
+            gradient[2] += c * k.y * k.y;
+        }
+        let sigma_f = var.sqrt();
+        let barrier = TransferBarrier::new(transfer, sigma_f);
+        let rows: Vec<Vec<f32>> = (0..TABLE_AZIMUTHS)
+            .into_par_iter()
+            .map(|a| {
+                let dir = DVec2::from_angle(PI * a as f64 / TABLE_AZIMUTHS as f64);
+                let process = LineProcess::new(
+                    noise
+                        .waves
+                        .iter()
+                        .map(|w| (0.5 * w.amplitude * w.amplitude, TAU * w.k.dot(dir))),
+                );
+                let grid = process.as_ref().map(|p| ProcessGrid::new(p, NU_MIN));
+                let mut out = Vec::with_capacity(TABLE_NUS * TRANSFER_ENTRY);
+                for j in 0..TABLE_NUS {
+                    let nu = NU_MIN * NU_RATIO.powi(j as i32);
+                    for i in 0..VALUE_NODES {
+                        let mut last = 0.0f64;
+                        for s in 0..SLOPE_NODES {
+                            let (x, t) = (value_node(i), slope_node(s));
+                            let v = match &grid {
+                                Some(_) if barrier.back_face(x, t, nu) && s > 0 => last,
+                                Some(g) => barrier_log_g1(g, &barrier, x, t, nu).max(-MAX_LOG_G1),
+                                None => 0.0,
+                            };
+                            last = v;
+                            out.push(stored(v) as f32);
+                        }
+                    }
+                }
+                out
+            })
+            .collect();
+        Some(Self {
+            sigma_f,
+            gradient,
+            data: rows.concat(),
+        })
+    }
+
+    /// The driver's global slope deviation along the unit direction `dir`.
+    pub fn slope_sigma(&self, dir: DVec2) -> f64 {
+        let [xx, xy, yy] = self.gradient;
+        (dir.x * dir.x * xx + 2.0 * dir.x * dir.y * xy + dir.y * dir.y * yy)
+            .max(0.0)
+            .sqrt()
+    }
+
+    /// The entry (`ln G1` at each node) of a ray of horizontal direction `dir` (unit) and slope
+    /// `nu`: [`stored`] bilinear in the azimuth and ln ν (clamped; non-finite inputs read the
+    /// first nodes).
+    pub fn lookup(&self, dir: DVec2, nu: f64) -> [f64; TRANSFER_ENTRY] {
+        let (a0, a1, fa) = azimuth_coordinate(dir);
+        let (n0, fnu) = nu_coordinate(nu);
+        let mut acc = [0.0f64; TRANSFER_ENTRY];
+        for (a, wa) in [(a0, 1.0 - fa), (a1, fa)] {
+            for (n, wn) in [(n0, 1.0 - fnu), (n0 + 1, fnu)] {
+                let w = wa * wn;
+                if w == 0.0 {
+                    continue;
+                }
+                let base = (a * TABLE_NUS + n) * TRANSFER_ENTRY;
+                for (o, v) in acc.iter_mut().zip(&self.data[base..base + TRANSFER_ENTRY]) {
+                    *o += w * f64::from(*v);
+                }
+            }
+        }
+        acc.map(|q| -q.exp())
+    }
+}
+
+/// Below this `−ln G1` counts as 0 in the stored logarithm ([`stored`]).
+pub const MIN_EXPONENT: f64 = 1e-6;
+
+/// What the table stores of `ln G1 ≤ 0`: `ln(max(−ln G1, MIN_EXPONENT))`, interpolated linearly
+/// over the azimuth and ln ν. The exponent `−ln G1` follows Smith's Λ(ν), which is convex in ln ν
+/// (exponential tails): interpolated as it is between nodes a ratio 1.5 apart it came out up to
+/// 0.08 too dark in P(clear) on terraces; its logarithm is close to linear there.
+pub fn stored(log_g1: f64) -> f64 {
+    (-log_g1).max(MIN_EXPONENT).ln()
+}
+
+/// `ln G1` of an entry at driver value `x` and slope `t` (both in σ), bilinear, clamped.
+pub fn entry_at(entry: &[f64; TRANSFER_ENTRY], x: f64, t: f64) -> f64 {
+    let (i, fi) = value_cell(x);
+    let (j, fj) = slope_cell(t);
+    let v = |i: usize, j: usize| entry[i * SLOPE_NODES + j];
+    (v(i, j) * (1.0 - fj) + v(i, j + 1) * fj) * (1.0 - fi)
+        + (v(i + 1, j) * (1.0 - fj) + v(i + 1, j + 1) * fj) * fi
+}
+
+/// How far the footprint is, for the blend with Smith's: `(σ_f,footprint/σ_f,global)²`, in
+/// [0, 1] (the share of the driver's variance the footprint leaves unresolved).
+/// 0 when the driver has no global spread (nothing to condition on).
+pub fn far_weight(footprint_std: f64, global_std: f64) -> f64 {
+    if !(global_std > 0.0) {
+        return 0.0;
+    }
+    let r = footprint_std / global_std;
+    if r.is_finite() {
+        (r * r).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
+}
+
+/// Points per axis of the Gauss–Hermite rule over the driver's slopes at a value
+/// ([`bin_visibility`]; the rule is their tensor product). 3 left the seen-and-lit share of a
+/// value band up to 0.12 off the per-point model on terraces (G1 falls within 1σ of t over a
+/// tread); 9 is within 0.04–0.07, as a 33 × 33 grid (docs/design.md).
+pub const RULE_POINTS: usize = 9;
+
+/// What one ray needs of the table: its entry and the projections of the driver's whitened
+/// gradient on its azimuth in σ units.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RayMasking {
+    /// The looked-up entry.
+    pub entry: [f64; TRANSFER_ENTRY],
+    /// The ray's ν.
+    pub nu: f64,
+    /// `t = p·ξ` for the whitened gradient ξ of the footprint (σ units of the table).
+    pub projection: DVec2,
+}
+
+/// The transfer mixture's bin visibility at driver value `x` (global σ): `(V̂o, V̂2)`, the mean
+/// of `G1o` and of the joint masking–shadowing over the driver's slopes at the value (the
+/// footprint's Gaussian, [`RULE_POINTS`]² nodes), weighted by the projected area toward the eye
+/// `max(0, 1 − G′(x)·t_o/ν_o)`, and the joint term also by the cosine toward the light
+/// `max(0, 1 − G′(x)·t_i/ν_i)` (what it multiplies is lit). The joint term
+/// combines the two conditioned `G1` as [`crate::microfacet::masking_shadowing::G2`] combines Λs
+/// (the more masked one times the other to the azimuth factor `k`: 1 when uncorrelated, 0 for
+/// a light along the view). `slope` is `G′(x)`. `None` when no node faces the eye.
+pub fn bin_visibility(
+    o: &RayMasking,
+    i: Option<&RayMasking>,
+    x: f64,
+    slope: f64,
+    k: f64,
+) -> Option<(f64, f64)> {
+    let (mut w_sum, mut w_lit, mut vo, mut v2) = (0.0, 0.0, 0.0, 0.0);
+    let (nodes, weights) = gauss_hermite_normal(RULE_POINTS);
+    let rule: Vec<(f64, f64)> = nodes.into_iter().zip(weights).collect();
+    for &(a, wa) in &rule {
+        for &(b, wb) in &rule {
+            let xi = DVec2::new(a, b);
+            let to = o.projection.dot(xi);
+            let u = (1.0 - slope * to / o.nu.max(1e-300)).max(0.0);
+            let w = wa * wb * u;
+            if w == 0.0 {
+                continue;
+            }
+            let go = entry_at(&o.entry, x, to).exp();
+            w_sum += w;
+            vo += w * go;
+            if let Some(i) = i {
+                // What the joint term multiplies is lit: weighted by the cosine toward the light.
+                let ti = i.projection.dot(xi);
+                let ui = (1.0 - slope * ti / i.nu.max(1e-300)).max(0.0);
+                let gi = entry_at(&i.entry, x, ti).exp();
+                let (lo, hi) = if go <= gi { (go, gi) } else { (gi, go) };
+                w_lit += w * ui;
+                v2 += w * ui * lo * hi.powf(k);
+            }
+        }
+    }
+    (w_sum > 0.0).then(|| (vo / w_sum, if w_lit > 0.0 { v2 / w_lit } else { 0.0 }))
+}
+
+/// A footprint's view and light against a [`TransferMaskingTable`]: what the transfer mixture's
+/// bins need to replace Smith's height-only visibility ([`TransferRays::bin_weights`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TransferRays {
+    o: RayMasking,
+    i: Option<RayMasking>,
+    k: f64,
+    /// The footprint's driver mean and deviation, in global σ.
+    mean: f64,
+    std: f64,
+    far: f64,
+}
+
+impl TransferRays {
+    /// For the footprint's driver `d`, `wo` and `wi` in the frame of its mean normal, the light
+    /// up or not, σ_h and the material's correlation.
+    pub fn new(
+        table: &TransferMaskingTable,
+        d: crate::driver::footprint::FilteredDriver,
+        (wo, wi): (glam::DVec3, glam::DVec3),
+        sun_lit: bool,
+        sigma_h: f64,
+        correlation: crate::microfacet::masking_shadowing::Correlation,
+    ) -> Self {
+        use crate::microfacet::masking_shadowing::{
+            Correlation, azimuth_difference, azimuth_factor,
+        };
+        let c = d.gradient_cov;
+        let (l11, l21, l22) = cholesky(c.xx, c.xy, c.yy);
+        let ray = |w: glam::DVec3| {
+            let r = w.x.hypot(w.y);
+            let dir = if r > 0.0 {
+                DVec2::new(w.x / r, w.y / r)
+            } else {
+                DVec2::X
+            };
+            let st = table.slope_sigma(dir).max(1e-300);
+            let nu = if r > 0.0 {
+                w.z.max(0.0) / r / (sigma_h.max(1e-300) * st)
+            } else {
+                f64::INFINITY
+            };
+            RayMasking {
+                entry: table.lookup(dir, nu),
+                nu,
+                projection: DVec2::new(dir.x * l11 + dir.y * l21, dir.y * l22) / st,
+            }
+        };
+        let k = match correlation {
+            Correlation::Uncorrelated => 1.0,
+            Correlation::HeightDirection => azimuth_factor(azimuth_difference(wo, wi)),
+        };
+        let sf = table.sigma_f.max(1e-300);
+        Self {
+            o: ray(wo),
+            i: sun_lit.then(|| ray(wi)),
+            k,
+            mean: d.mean / sf,
+            std: d.std / sf,
+            far: far_weight(d.std, table.sigma_f),
+        }
+    }
+
+    /// `(V̂o, V̂2)` of [`bin_visibility`] at driver value `x` (global σ) with `G′ = slope`.
+    pub fn visibility_at(&self, x: f64, slope: f64) -> Option<(f64, f64)> {
+        bin_visibility(&self.o, self.i.as_ref(), x, slope, self.k)
+    }
+
+    /// The bin of quantiles `[lo, hi]` (mean g′ `slope`): its weight times its mean visibility
+    /// along ωo, and along both ωo and ωi, from the conditioned masking at the bin's median
+    /// value ([`bin_visibility`]), blended with Smith's `smith = (W1, W2)` geometrically by
+    /// [`far_weight`]. Smith's where no node faces the eye.
+    pub fn bin_weights(&self, lo: f64, hi: f64, slope: f64, smith: (f64, f64)) -> (f64, f64) {
+        let x = self.mean + self.std * crate::math::special::norm_quantile(0.5 * (lo + hi));
+        let Some((vo, v2)) = bin_visibility(&self.o, self.i.as_ref(), x, slope, self.k) else {
+            return smith;
+        };
+        let blend = |s: f64, c: f64| {
+            if self.far >= 1.0 {
+                c
+            } else if s > 0.0 && c > 0.0 {
+                s.powf(1.0 - self.far) * c.powf(self.far)
+            } else {
+                0.0
+            }
+        };
+        let width = (hi - lo).max(0.0);
+        (blend(smith.0, width * vo), blend(smith.1, width * v2))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::eval::test_materials::preset;
+
+    fn terraces_table() -> (crate::material::Material, Arc<TransferMaskingTable>) {
+        let m = preset("terraces");
+        let t = TransferMaskingTable::shared(&m.noise().expect("noise"), &m.heights.transfer)
+            .expect("a table");
+        (m, t)
+    }
+
+    /// At an azimuth node and a ν node the lookup is the direct conditioned masking at every
+    /// (value, slope) node (the layout, the stored logarithm and its f32 round trip), back faces
+    /// hold the last front value, and nothing is NaN between or beyond the nodes.
+    #[test]
+    fn the_lookup_at_nodes_is_the_direct_masking() {
+        let (m, table) = terraces_table();
+        let noise = m.noise().expect("noise");
+        let barrier = TransferBarrier::new(&m.heights.transfer, table.sigma_f);
+        for (a, j) in [(0usize, 3usize), (3, 8), (6, 11)] {
+            let dir = DVec2::from_angle(PI * a as f64 / TABLE_AZIMUTHS as f64);
+            let nu = NU_MIN * NU_RATIO.powi(j as i32);
+            let process = LineProcess::new(
+                noise
+                    .waves
+                    .iter()
+                    .map(|w| (0.5 * w.amplitude * w.amplitude, TAU * w.k.dot(dir))),
+            )
+            .expect("a process");
+            let grid = ProcessGrid::new(&process, NU_MIN);
+            let entry = table.lookup(dir, nu);
+            let mut checked = 0;
+            for i in (0..VALUE_NODES).step_by(3) {
+                for s in 0..SLOPE_NODES {
+                    let (x, t) = (value_node(i), slope_node(s));
+                    let got = entry[i * SLOPE_NODES + s];
+                    if barrier.back_face(x, t, nu) {
+                        assert_eq!(got, entry[i * SLOPE_NODES + s - 1], "({x}, {t})");
+                        continue;
+                    }
+                    let want = barrier_log_g1(&grid, &barrier, x, t, nu).max(-MAX_LOG_G1);
+                    let tol = 1e-4 * (1.0 + want.abs()) + MIN_EXPONENT;
+                    assert!(
+                        (got - want).abs() <= tol,
+                        "({x}, {t}), ν {nu}: {got} vs {want}"
+                    );
+                    checked += 1;
+                }
+            }
+            assert!(checked > 50, "{checked}");
+        }
+        for dir in [DVec2::new(f64::NAN, 0.0), DVec2::new(0.3, -0.95)] {
+            for nu in [f64::NAN, -1.0, 0.0, 1e-9, 0.77, 1e9, f64::INFINITY] {
+                let e = table.lookup(dir, nu);
+                assert!(e.iter().all(|v| v.is_finite() && *v <= 0.0), "{dir} {nu}");
+                assert!(entry_at(&e, f64::NAN, 0.3).is_finite());
+            }
+        }
+    }
+
+    /// With no masking (ln G1 ≡ 0) every value is seen and lit; with G1 falling as the driver
+    /// rises toward the ray, the joint term of a light opposite the eye is below the product of
+    /// the two means (one slope makes a start hard to see and easy to light: Chebyshev's
+    /// inequality for a decreasing and an increasing function of t), and along the eye it is
+    /// above it; a sun below the horizon lights nothing.
+    #[test]
+    fn the_bin_visibility_follows_the_hidden_slope() {
+        let ray = |entry: [f64; TRANSFER_ENTRY], p: DVec2| RayMasking {
+            entry,
+            nu: 1.0,
+            projection: p,
+        };
+        let flat = ray([0.0; TRANSFER_ENTRY], DVec2::X);
+        assert_eq!(
+            bin_visibility(&flat, Some(&flat), 0.3, 0.0, 1.0),
+            Some((1.0, 1.0))
+        );
+        let mut falling = [0.0; TRANSFER_ENTRY];
+        for i in 0..VALUE_NODES {
+            for s in 0..SLOPE_NODES {
+                falling[i * SLOPE_NODES + s] = -0.4 * (slope_node(s) + 4.0);
+            }
+        }
+        let o = ray(falling, DVec2::X);
+        let (vo, _) = bin_visibility(&o, None, 0.0, 0.0, 1.0).expect("front faces");
+        assert!(vo > 0.0 && vo < 1.0, "{vo}");
+        let opposite = ray(falling, -DVec2::X);
+        let (_, v_opp) = bin_visibility(&o, Some(&opposite), 0.0, 0.0, 1.0).expect("lit");
+        let (_, v_same) = bin_visibility(&o, Some(&o), 0.0, 0.0, 1.0).expect("lit");
+        assert!(v_opp < 0.95 * vo * vo, "{v_opp} vs {}", vo * vo);
+        assert!(v_same > 1.05 * vo * vo, "{v_same} vs {}", vo * vo);
+        // A flat tread (G′ = 0) weighs every slope alike; no node faces the eye → None.
+        assert!(bin_visibility(&o, None, 0.0, 1e6, 1.0).is_some());
+        let steep = RayMasking {
+            projection: DVec2::ZERO,
+            nu: 1e-9,
+            ..o.clone()
+        };
+        assert!(bin_visibility(&steep, None, 0.0, 1.0, 1.0).is_some());
+        assert_eq!(far_weight(1.0, 1.0), 1.0);
+        assert_eq!(far_weight(0.5, 1.0), 0.25);
+        assert_eq!(far_weight(f64::NAN, 1.0), 0.0);
+        assert_eq!(far_weight(3.0, 0.0), 0.0);
+    }
+}
