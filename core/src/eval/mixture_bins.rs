@@ -20,6 +20,14 @@
 //! integrated exactly (tested). Against the 241-node mixture ([`Evaluator::filtered_mixture`]) on
 //! the moss, sponge and terraces presets: within 0.1%, 0.8% and 3.0% (terraces at 75°; a riser
 //! whose g′ runs from 0 to its peak inside one bin is still one Gaussian).
+//!
+//! **Conditioned on the driver's slope (CPU prototype, #17).** With
+//! [`Evaluator::transfer_masking`] set (only measurements set it), each bin is also summed node by
+//! node over the driver's slopes at its median value ([`CONDITIONED_SLOPE_POINTS`]), each node
+//! weighted by its projected area, its conditioned G1 along ωo and its joint masking–shadowing
+//! ([`crate::eval::transfer_masking_table::TransferRays::node_visibility`]), and the two are
+//! blended by the footprint's far weight (docs/design.md, "Transfer curves: masking that knows
+//! the driver's slope").
 
 use crate::driver::conditional_slopes::ImageSlopes;
 use crate::eval::query::FootprintStats;
@@ -27,12 +35,20 @@ use crate::eval::shading::{SlopeShading, specular_tint};
 use crate::eval::transfer_masking_table::TransferRays;
 use crate::eval::{Evaluator, FootprintQuery};
 use crate::material::transfer::TransferFunction;
+use crate::math::gaussian::cholesky;
 use crate::math::special::norm_quantile;
 use crate::microfacet::height_mixture::{
     BIN_SAMPLES, bin_exponent, bin_masking, bin_slope_points, mixture_edges,
 };
 use crate::microfacet::masking_shadowing::G2;
-use glam::{DMat3, DVec3};
+use crate::microfacet::slopes::normal_of;
+use crate::microfacet::visible_slopes::slope_rule;
+use glam::{DMat3, DVec2, DVec3};
+
+/// n of the polar rule (n² nodes) over a bin's slopes when its masking is conditioned on the
+/// driver's slope ([`crate::eval::transfer_masking_table`]): the visibility turns within 1σ of
+/// the driver's slope over a tread, where the shading alone would need few nodes.
+pub const CONDITIONED_SLOPE_POINTS: usize = 8;
 use std::f64::consts::FRAC_1_PI;
 
 /// What a bin of the driver's value contributes: its mean g′, the root mean square of g′ and the
@@ -154,29 +170,57 @@ impl Evaluator {
             let mean = d.mean_gradient * (sigma_h * bin.mean_deriv);
             let cov = d.gradient_cov.scaled(sigma_h * bin.rms_deriv);
             let ms = G2::from_directions(wo, wi, &cov, m.filtering.correlation);
-            let mut w1 = bin_masking(lo, hi, ms.lambda_o, above_o);
-            let mut w2 = bin_masking(lo, hi, ms.total, above);
+            let w1 = bin_masking(lo, hi, ms.lambda_o, above_o);
+            let w2 = bin_masking(lo, hi, ms.total, above);
             above_o += bin_exponent(lo, hi, ms.lambda_o);
             above += bin_exponent(lo, hi, ms.total);
-            if let Some(c) = &conditioned {
-                (w1, w2) = c.bin_weights(lo, hi, bin.mean_deriv, (w1, w2));
-            }
             let (s, s_o): (SlopeShading, f64) =
                 self.visible_shading_sums(mean, &cov, cfg.wo, cfg.wi, frame, points);
-            den += w1 * s_o;
-            let (v, spec) = if sun_lit {
-                let lobe = self.specular_lobes(mean, &cov, cfg.wo, cfg.wi);
-                (w2 * sun, lobe.map(|l| l * s_o))
-            } else {
-                (0.0, [0.0; 3])
-            };
             let c = m.terms.affine(bin.color);
-            let tint = specular_tint(&weights, &c, &s);
-            for ch in 0..3 {
-                let kd = kd * weights.kd[ch];
-                num[ch] += v
-                    * (kd * (c.a[ch] * s.cos + c.k[ch] * s.cs_cos[ch]) + spec[ch] * tint[ch])
-                    + w1 * kd * (c.a[ch] * s.env[ch] + c.k[ch] * s.cs_env[ch]);
+            // Smith's bin, or the conditioned one blended with it by the footprint's far weight.
+            let mut parts = vec![(1.0, (w1, w2), (s, s_o), (s, s_o))];
+            if let Some(rays) = &conditioned {
+                let x = rays.value_at(0.5 * (lo + hi));
+                let (l11, l21, l22) =
+                    cholesky(d.gradient_cov.xx, d.gradient_cov.xy, d.gradient_cov.yy);
+                let (mut s1, mut s1o, mut s2, mut s2o) =
+                    (SlopeShading::default(), 0.0, SlopeShading::default(), 0.0);
+                for (z, wz) in slope_rule(points.max(CONDITIONED_SLOPE_POINTS)) {
+                    let tf = DVec2::new(l11 * z.x, l21 * z.x + l22 * z.y);
+                    let sl = mean + tf * (sigma_h * bin.rms_deriv);
+                    let u = (cfg.wo.z - sl.x * cfg.wo.x - sl.y * cfg.wo.y).max(0.0);
+                    if u == 0.0 {
+                        continue;
+                    }
+                    let shade = self.point_shading(normal_of(sl), cfg.wi, frame);
+                    let (go, g2) = rays.node_visibility(x, *z);
+                    s1.add(&shade, wz * u * go);
+                    s1o += wz * u * go;
+                    s2.add(&shade, wz * u * g2);
+                    s2o += wz * u * g2;
+                }
+                let width = hi - lo;
+                parts[0].0 = 1.0 - rays.far();
+                parts.push((rays.far(), (width, width), (s1, s1o), (s2, s2o)));
+            }
+            for (share, (w1, w2), (s1, s1o), (s2, s2o)) in parts {
+                if share == 0.0 {
+                    continue;
+                }
+                den += share * w1 * s1o;
+                let (v, spec) = if sun_lit {
+                    let lobe = self.specular_lobes(mean, &cov, cfg.wo, cfg.wi);
+                    (share * w2 * sun, lobe.map(|l| l * s2o))
+                } else {
+                    (0.0, [0.0; 3])
+                };
+                let tint = specular_tint(&weights, &c, &s2);
+                for ch in 0..3 {
+                    let kd = kd * weights.kd[ch];
+                    num[ch] += v
+                        * (kd * (c.a[ch] * s2.cos + c.k[ch] * s2.cs_cos[ch]) + spec[ch] * tint[ch])
+                        + share * w1 * kd * (c.a[ch] * s1.env[ch] + c.k[ch] * s1.cs_env[ch]);
+                }
             }
         }
         if !(den > 0.0) {

@@ -1,6 +1,6 @@
 //! A transfer-curve material's table of masking conditioned on the driver's value and slope
-//! ([`crate::microfacet::barrier_masking`], #17), and the visibility of the transfer mixture's
-//! bins it gives ([`bin_visibility`]).
+//! ([`crate::microfacet::barrier_masking`], #17), and what the transfer mixture's bins take from it
+//! ([`TransferRays`]).
 //!
 //! Entry: `ln G1(x_i, t_j)` at [`VALUE_NODES`] driver values `x_i` ([`value_node`], in the
 //! driver's global σ) × [`SLOPE_NODES`] driver slopes along the ray `t_j` ([`slope_node`], in the
@@ -259,7 +259,9 @@ pub struct RayMasking {
     pub projection: DVec2,
 }
 
-/// The transfer mixture's bin visibility at driver value `x` (global σ): `(V̂o, V̂2)`, the mean
+/// One number per bin instead of the bins' node-by-node sums (what the measurements compare
+/// with the per-point model, `transfer_conditioned_masking_prototype`): the bin visibility at
+/// driver value `x` (global σ), `(V̂o, V̂2)`, the mean
 /// of `G1o` and of the joint masking–shadowing over the driver's slopes at the value (the
 /// footprint's Gaussian, [`RULE_POINTS`]² nodes), weighted by the projected area toward the eye
 /// `max(0, 1 − G′(x)·t_o/ν_o)`, and the joint term also by the cosine toward the light
@@ -304,7 +306,7 @@ pub fn bin_visibility(
 }
 
 /// A footprint's view and light against a [`TransferMaskingTable`]: what the transfer mixture's
-/// bins need to replace Smith's height-only visibility ([`TransferRays::bin_weights`]).
+/// bins need to replace Smith's height-only visibility ([`TransferRays::node_visibility`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TransferRays {
     o: RayMasking,
@@ -366,31 +368,33 @@ impl TransferRays {
         }
     }
 
+    /// `(G1o, G2)` of one start at driver value `x` (global σ) whose driver gradient is the
+    /// footprint's Gaussian at the standard node `z` (`∇f = L z`, L the Cholesky factor of its
+    /// unresolved gradient covariance): the conditioned masking along ωo, and the joint
+    /// masking–shadowing combined as in [`bin_visibility`] (0 with the sun down).
+    pub fn node_visibility(&self, x: f64, z: DVec2) -> (f64, f64) {
+        let go = entry_at(&self.o.entry, x, self.o.projection.dot(z)).exp();
+        let g2 = self.i.as_ref().map_or(0.0, |i| {
+            let gi = entry_at(&i.entry, x, i.projection.dot(z)).exp();
+            let (lo, hi) = if go <= gi { (go, gi) } else { (gi, go) };
+            lo * hi.powf(self.k)
+        });
+        (go, g2)
+    }
+
+    /// The share of the footprint's driver variance it leaves unresolved ([`far_weight`]).
+    pub fn far(&self) -> f64 {
+        self.far
+    }
+
+    /// The driver value (global σ) at quantile `u` of the footprint.
+    pub fn value_at(&self, u: f64) -> f64 {
+        self.mean + self.std * crate::math::special::norm_quantile(u)
+    }
+
     /// `(V̂o, V̂2)` of [`bin_visibility`] at driver value `x` (global σ) with `G′ = slope`.
     pub fn visibility_at(&self, x: f64, slope: f64) -> Option<(f64, f64)> {
         bin_visibility(&self.o, self.i.as_ref(), x, slope, self.k)
-    }
-
-    /// The bin of quantiles `[lo, hi]` (mean g′ `slope`): its weight times its mean visibility
-    /// along ωo, and along both ωo and ωi, from the conditioned masking at the bin's median
-    /// value ([`bin_visibility`]), blended with Smith's `smith = (W1, W2)` geometrically by
-    /// [`far_weight`]. Smith's where no node faces the eye.
-    pub fn bin_weights(&self, lo: f64, hi: f64, slope: f64, smith: (f64, f64)) -> (f64, f64) {
-        let x = self.mean + self.std * crate::math::special::norm_quantile(0.5 * (lo + hi));
-        let Some((vo, v2)) = bin_visibility(&self.o, self.i.as_ref(), x, slope, self.k) else {
-            return smith;
-        };
-        let blend = |s: f64, c: f64| {
-            if self.far >= 1.0 {
-                c
-            } else if s > 0.0 && c > 0.0 {
-                s.powf(1.0 - self.far) * c.powf(self.far)
-            } else {
-                0.0
-            }
-        };
-        let width = (hi - lo).max(0.0);
-        (blend(smith.0, width * vo), blend(smith.1, width * v2))
     }
 }
 
@@ -498,5 +502,47 @@ mod tests {
         assert_eq!(far_weight(0.5, 1.0), 0.25);
         assert_eq!(far_weight(f64::NAN, 1.0), 0.0);
         assert_eq!(far_weight(3.0, 0.0), 0.0);
+    }
+
+    /// The filtered view with the conditioned bins: at the normal, where nothing is masked or
+    /// shadowed, it is Smith's bins (to the table's last ν node, G1 ≥ 0.999 there); everywhere
+    /// else finite and non-negative, grazing and below the horizon included.
+    #[test]
+    fn the_conditioned_bins_are_smiths_where_nothing_is_masked() {
+        use crate::eval::{Evaluator, FootprintQuery};
+        use crate::scene::direction::direction;
+        for name in ["terraces", "sponge"] {
+            let m = preset(name);
+            let smith = Evaluator::new(&m).expect("prepared");
+            let mut own = smith.clone();
+            own.transfer_masking =
+                TransferMaskingTable::shared(&m.noise().expect("noise"), &m.heights.transfer);
+            let at = |e: &Evaluator, v: f64, l: f64, az: f64| {
+                let cfg = FootprintQuery::far(
+                    e,
+                    direction(v.to_radians(), 0.0),
+                    direction(l.to_radians(), az.to_radians()),
+                );
+                e.filtered(&cfg)
+            };
+            let (a, b) = (at(&smith, 0.0, 0.0, 0.0), at(&own, 0.0, 0.0, 0.0));
+            for k in 0..3 {
+                assert!((a[k] - b[k]).abs() <= 3e-3 * a[k], "{name}: {a:?} vs {b:?}");
+            }
+            // Shadowing moves it: the light at 60° opposite the eye at 60°.
+            let (a, b) = (at(&smith, 60.0, 60.0, 180.0), at(&own, 60.0, 60.0, 180.0));
+            if name == "terraces" {
+                assert!(b[0] < 0.95 * a[0], "{a:?} vs {b:?}");
+            }
+            for v in [0.0, 45.0, 85.0, 89.5] {
+                for (l, az) in [(0.0, 0.0), (60.0, 180.0), (89.9, 0.0), (120.0, 90.0)] {
+                    let r = at(&own, v, l, az);
+                    assert!(
+                        r.iter().all(|c| c.is_finite() && *c >= 0.0),
+                        "{v} {l} {az}: {r:?}"
+                    );
+                }
+            }
+        }
     }
 }
