@@ -191,6 +191,10 @@ fn transfer_conditioned_masking_prototype() {
         // the sun), Σu·clear, Σu·G1i; radiance sums: truth, model.
         let mut bins = [[0.0f64; 8]; 8];
         let (mut tl, mut tw, mut ml, mut mw) = ([0.0; 3], 0.0, [0.0; 3], 0.0);
+        let (mut vl, mut vw) = ([0.0; 3], 0.0);
+        let k_az = crate::microfacet::masking_shadowing::azimuth_factor(
+            crate::microfacet::masking_shadowing::azimuth_difference(wo, wi),
+        );
         for _ in 0..n_points {
             let Some(FrontPoint { x, f, h, grad, u }) = front_point(s, wo, &mut rng) else {
                 continue;
@@ -229,12 +233,23 @@ fn transfer_conditioned_masking_prototype() {
                 b[5] += u * gi;
                 b[7] += u * from_table(&entry_i, f, gf.dot(d_i) / st_i);
             }
+            // The views' form at the same point: the table's G1, combined as G2 combines Λs.
+            let to = from_table(&entry_o, f, gf.dot(d_o) / st_o);
+            let ti = if faces {
+                from_table(&entry_i, f, gf.dot(d_i) / st_i)
+            } else {
+                0.0
+            };
+            let (lo, hi) = if to <= ti { (to, ti) } else { (ti, to) };
+            let t2 = lo * hi.powf(k_az);
             for k in 0..3 {
                 if seen {
                     tl[k] += u * if clear { l1[k] } else { l0[k] };
                 }
                 ml[k] += u * go * (gi * l1[k] + (1.0 - gi) * l0[k]);
+                vl[k] += u * (t2 * l1[k] + (to - t2).max(0.0) * l0[k]);
             }
+            vw += u * to;
             if seen {
                 tw += u;
             }
@@ -243,6 +258,12 @@ fn transfer_conditioned_masking_prototype() {
         let err = (0..3)
             .map(|k| 100.0 * (ml[k] / mw - tl[k] / tw) / (tl[k] / tw))
             .fold(0.0f64, |a, e| if e.abs() > a.abs() { e } else { a });
+        let err_table = (0..3)
+            .map(|k| 100.0 * (vl[k] / vw - tl[k] / tw) / (tl[k] / tw))
+            .fold(0.0f64, |a, e| if e.abs() > a.abs() { e } else { a });
+        eprintln!(
+            "    per point with the views' table and G2 combination: {err_table:+.2}% against the point truth"
+        );
         let cells: Vec<String> = bins
             .iter()
             .map(|b| {
