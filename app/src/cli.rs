@@ -214,6 +214,24 @@ pub enum Command {
         #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
         frames: u32,
     },
+    /// Write a MERL-format isotropic BRDF table (`.binary`, 90×90×180 half/difference angles, 35
+    /// MB) of an analytic plastic: Lambert diffuse plus a GGX lobe with Schlick's Fresnel. For a
+    /// preset that references a measured BRDF without the MERL database at hand (the library's
+    /// `presets/measured/red-plastic.ron` is written with the defaults).
+    Merl {
+        /// The file to write (atomically).
+        #[arg(long)]
+        out: PathBuf,
+        /// Diffuse albedo per channel (linear RGB), 0 to 1 each, comma-separated.
+        #[arg(long, default_value = "0.5,0.06,0.05", value_delimiter = ',', value_parser = unit_fraction)]
+        diffuse: Vec<f64>,
+        /// Fresnel reflectance at normal incidence (Schlick's F0), 0 to 1.
+        #[arg(long, default_value_t = 0.04, value_parser = unit_fraction)]
+        f0: f64,
+        /// GGX roughness α, 0.01 to 1.
+        #[arg(long, default_value_t = 0.15, value_parser = ggx_alpha)]
+        alpha: f64,
+    },
     /// Parse and validate a preset; exit code 2 and every problem on failure.
     Validate,
     /// Print the preset (the built-in default when --preset is omitted) as RON.
@@ -399,6 +417,16 @@ fn number_in(s: &str, lo: f64, hi: f64, what: &str) -> Result<f64, String> {
         return Err(format!("{what} must be between {lo} and {hi}, got {s}"));
     }
     Ok(v)
+}
+
+/// A reflectance or albedo: 0 to 1.
+fn unit_fraction(s: &str) -> Result<f64, String> {
+    number_in(s, 0.0, 1.0, "a reflectance")
+}
+
+/// A GGX roughness α: 0.01 to 1.
+fn ggx_alpha(s: &str) -> Result<f64, String> {
+    number_in(s, 0.01, 1.0, "the GGX roughness α")
 }
 
 /// A relative standard error to reach, 0.0001 to 0.5.

@@ -348,6 +348,41 @@ fn run(cli: Cli) -> Result<()> {
                 out!("{}", i.to_text());
             }
         }
+        Some(Command::Merl {
+            out,
+            diffuse,
+            f0,
+            alpha,
+        }) => {
+            use lodestone_core::material::merl::{MerlBrdf, ggx_reference};
+            let [r, g, b] = diffuse[..] else {
+                return Err(UsageError(format!(
+                    "--diffuse takes three values (red, green, blue), got {}",
+                    diffuse.len()
+                ))
+                .into());
+            };
+            if out.is_dir() {
+                return Err(UsageError(format!("--out {}: is a folder", out.display())).into());
+            }
+            if let Some(dir) = out
+                .parent()
+                .filter(|d| !d.as_os_str().is_empty() && !d.is_dir())
+            {
+                return Err(UsageError(format!(
+                    "--out {}: the folder {} does not exist",
+                    out.display(),
+                    dir.display()
+                ))
+                .into());
+            }
+            let table = MerlBrdf::tabulate(ggx_reference([r, g, b], [f0; 3], alpha));
+            preset_io::write_atomic_bytes(&out, &table.to_bytes())?;
+            outln!(
+                "wrote {} (MERL BRDF: diffuse {r}, {g}, {b}; F0 {f0}; GGX α {alpha})",
+                out.display()
+            );
+        }
         Some(Command::Validate) => outln!("ok: {} is a valid preset", material.name),
         Some(Command::Show) => outln!("{}", material.to_ron()),
         Some(Command::Stability { json, cpu_only }) => stability::run(json, cpu_only)?,

@@ -241,7 +241,14 @@ pub fn load_measured(preset: &Path, file: &Path) -> Result<MeasuredBrdf, PresetE
         file: file.to_owned(),
         reason,
     };
-    check_regular_file(file, MAX_IMAGE_FILE_BYTES).map_err(|e| err(e.to_string()))?;
+    check_regular_file(file, MAX_IMAGE_FILE_BYTES).map_err(|e| {
+        let hint = if file.exists() {
+            ""
+        } else {
+            " (a file of the MERL database, or an analytic one written by `lodestone merl --out FILE`)"
+        };
+        err(format!("{e}{hint}"))
+    })?;
     let table = MerlBrdf::read(file).map_err(|e| err(e.to_string()))?;
     Ok(MeasuredBrdf::new(table))
 }

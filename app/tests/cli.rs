@@ -597,6 +597,99 @@ fn environment_file_matches_the_procedural_sky_and_a_missing_one_exits_2() {
     );
 }
 
+/// The library's measured preset (#18 §2): `presets/measured/red-plastic.ron` names a MERL file
+/// beside it that the repository does not keep. Without it the preset exits 2 and says how to get
+/// one; `lodestone merl` writes exactly the tabulated red plastic (byte for byte), and then the
+/// preset evaluates, red; bad `merl` arguments exit 2 before any work.
+#[test]
+fn the_measured_library_preset_gets_its_table_from_lodestone_merl() {
+    use lodestone_core::material::merl::{MerlBrdf, ggx_reference};
+    let dir =
+        std::env::temp_dir().join(format!("lodestone-cli-red-plastic-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let preset = dir.join("red-plastic.ron");
+    std::fs::write(
+        &preset,
+        include_str!("../../presets/measured/red-plastic.ron"),
+    )
+    .unwrap();
+    let table = dir.join("red-plastic.binary");
+    let _ = std::fs::remove_file(&table);
+    let eval = || {
+        lodestone(&[
+            "--preset",
+            preset.to_str().unwrap(),
+            "eval",
+            "--view-deg",
+            "45",
+            "--light-deg",
+            "30",
+            "--spp",
+            "400",
+            "--json",
+        ])
+    };
+    let out = eval();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("red-plastic.binary") && err.contains("lodestone merl"),
+        "{err}"
+    );
+    let out = lodestone(&["merl", "--out", table.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let want = MerlBrdf::tabulate(ggx_reference([0.5, 0.06, 0.05], [0.04; 3], 0.15)).to_bytes();
+    assert!(
+        std::fs::read(&table).unwrap() == want,
+        "not the tabulated red plastic"
+    );
+    let out = eval();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let truth: Vec<f64> = (0..3)
+        .map(|k| v["ground_truth"][k].as_f64().unwrap())
+        .collect();
+    assert!(truth[0] > 3.0 * truth[1] && truth[1] > 0.0, "{truth:?}");
+    for bad in [
+        vec![
+            "merl",
+            "--out",
+            table.to_str().unwrap(),
+            "--diffuse",
+            "0.5,0.5",
+        ],
+        vec!["merl", "--out", table.to_str().unwrap(), "--alpha", "0"],
+        vec!["merl", "--out", table.to_str().unwrap(), "--f0", "NaN"],
+        vec![
+            "merl",
+            "--out",
+            dir.join("no/such/folder.binary").to_str().unwrap(),
+        ],
+        vec!["merl", "--out", dir.to_str().unwrap()],
+    ] {
+        let out = lodestone(&bad);
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{bad:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    assert!(
+        std::fs::read(&table).unwrap() == want,
+        "a refused run touched the file"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A measured BRDF beside the preset (#18 §2): a MERL file of a Lambertian BRDF of albedo 0.8
 /// evaluates like the analytic Lambertian of albedo 0.8 in every method; bad files (missing,
 /// truncated, NaN, mostly negative) exit 2 with a message that names the file and the fault, and
