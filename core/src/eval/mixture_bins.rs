@@ -25,7 +25,8 @@
 //! [`Evaluator::transfer_masking`] set (only measurements set it), each bin is also summed node by
 //! node over the driver's slopes at its median value ([`CONDITIONED_SLOPE_POINTS`]), each node
 //! weighted by its projected area, its conditioned G1 along ωo and its joint masking–shadowing
-//! ([`crate::eval::transfer_masking_table::TransferRays::node_visibility`]), and the two are
+//! ([`crate::eval::transfer_masking_table::TransferRays::node_visibility`]); the specular lobe
+//! takes the joint term over the driver slopes of its half-vector posterior; and the two are
 //! blended by the footprint's far weight (docs/design.md, "Transfer curves: masking that knows
 //! the driver's slope").
 
@@ -37,6 +38,7 @@ use crate::eval::{Evaluator, FootprintQuery};
 use crate::material::transfer::TransferFunction;
 use crate::math::gaussian::cholesky;
 use crate::math::special::norm_quantile;
+use crate::microfacet::brdf::half_vector_posterior;
 use crate::microfacet::height_mixture::{
     BIN_SAMPLES, bin_exponent, bin_masking, bin_slope_points, mixture_edges,
 };
@@ -199,9 +201,31 @@ impl Evaluator {
                     s2.add(&shade, wz * u * g2);
                     s2o += wz * u * g2;
                 }
+                // The lobe's facets are not the average facet: its visibility is G2 over the
+                // driver slopes of the lobe's posterior (the facets near the half vector), on the
+                // same rule; the average where the bin has no slope to select them by.
+                let scale = sigma_h * bin.rms_deriv;
+                let lobe_vis = half_vector_posterior(mean, &cov, cfg.wo, cfg.wi, m.brdf.roughness)
+                    .filter(|_| scale > 1e-12 && sun_lit)
+                    .map(|(pm, pc)| {
+                        let tm = (pm - mean) / scale;
+                        let (a11, a21, a22) = cholesky(pc.xx, pc.xy, pc.yy);
+                        let (mut acc, mut wsum) = (0.0, 0.0);
+                        for (z, wz) in slope_rule(points.max(CONDITIONED_SLOPE_POINTS)) {
+                            let tf = tm + DVec2::new(a11 * z.x, a21 * z.x + a22 * z.y) / scale;
+                            acc += wz * rays.gradient_visibility(x, tf).1;
+                            wsum += wz;
+                        }
+                        if wsum > 0.0 { acc / wsum } else { 0.0 }
+                    });
                 let width = hi - lo;
                 parts[0].0 = 1.0 - rays.far();
-                parts.push((rays.far(), (width, width), (s1, s1o), (s2, s2o)));
+                parts.push((
+                    rays.far(),
+                    (width, width),
+                    (s1, s1o),
+                    (s2, lobe_vis.map_or(s2o, |v| v * s_o)),
+                ));
             }
             for (share, (w1, w2), (s1, s1o), (s2, s2o)) in parts {
                 if share == 0.0 {

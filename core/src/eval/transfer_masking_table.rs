@@ -309,6 +309,8 @@ pub fn bin_visibility(
 /// bins need to replace Smith's height-only visibility ([`TransferRays::node_visibility`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct TransferRays {
+    /// The Cholesky factor of the footprint's unresolved driver-gradient covariance.
+    chol: (f64, f64, f64),
     o: RayMasking,
     i: Option<RayMasking>,
     k: f64,
@@ -359,6 +361,7 @@ impl TransferRays {
         };
         let sf = table.sigma_f.max(1e-300);
         Self {
+            chol: (l11, l21, l22),
             o: ray(wo),
             i: sun_lit.then(|| ray(wi)),
             k,
@@ -380,6 +383,19 @@ impl TransferRays {
             lo * hi.powf(self.k)
         });
         (go, g2)
+    }
+
+    /// [`TransferRays::node_visibility`] of a start whose driver gradient is `grad` (driver
+    /// units; a direction the footprint's gradient has no spread in reads its mean, 0).
+    pub fn gradient_visibility(&self, x: f64, grad: DVec2) -> (f64, f64) {
+        let (l11, l21, l22) = self.chol;
+        let z1 = if l11 > 0.0 { grad.x / l11 } else { 0.0 };
+        let z2 = if l22 > 0.0 {
+            (grad.y - l21 * z1) / l22
+        } else {
+            0.0
+        };
+        self.node_visibility(x, DVec2::new(z1, z2))
     }
 
     /// The share of the footprint's driver variance it leaves unresolved ([`far_weight`]).
