@@ -44,6 +44,49 @@ pub(super) fn front_point(
     (u > 0.0).then_some(FrontPoint { x, f, h, grad, u })
 }
 
+/// A [`front_point`] with its rays traced and its radiance lit and unlit (`shade_hit`): the
+/// driver's value and gradient, its unit normal, its projected area toward ωo, whether the eye sees it, whether it
+/// faces the sun, and whether the ray to the sun is clear (self-shadowing is the clamped
+/// cosine's: `clear` asks only whether other surface blocks the sun, for the points that face it).
+pub(super) struct TracedPoint {
+    pub f: f64,
+    pub grad_f: DVec2,
+    pub normal: DVec3,
+    pub u: f64,
+    pub seen: bool,
+    pub faces: bool,
+    pub clear: bool,
+    pub lit: [f64; 3],
+    pub unlit: [f64; 3],
+}
+
+pub(super) fn traced_point(
+    p: &crate::eval::Evaluator,
+    wo: DVec3,
+    wi: DVec3,
+    rng: &mut u64,
+) -> Option<TracedPoint> {
+    use crate::microfacet::slopes::normal_of;
+    use glam::DMat3;
+    let s = &p.surface;
+    let FrontPoint { x, f, h, grad, u } = front_point(s, wo, rng)?;
+    let (_, grad_f) = s.driver.value_and_gradient(x);
+    let n = normal_of(grad);
+    let pt = DVec3::new(x.x, x.y, h);
+    let faces = n.dot(wi) > 0.0;
+    Some(TracedPoint {
+        f,
+        grad_f,
+        normal: n,
+        u,
+        seen: s.sees(pt, wo),
+        faces,
+        clear: faces && s.sees(pt, wi),
+        lit: p.shade_hit(f, n, wo, wi, &DMat3::IDENTITY, || true),
+        unlit: p.shade_hit(f, n, wo, wi, &DMat3::IDENTITY, || false),
+    })
+}
+
 /// Why the specular lobe is off in the slope distribution's tails (#17, bumpy-specular): the
 /// density of the noise's slopes (σ_h ∇f of a sum of sinusoids, phases uniform: the footprint's
 /// statistics far away) at the half vectors of the failing configurations, by Monte Carlo over the

@@ -3,11 +3,10 @@
 //! a visibility that knows the point's driver value alone leaves, against one that also knows the
 //! driver's slope along the view's azimuth (docs/design.md, "Transfer curves").
 
-use super::measurements::{FrontPoint, front_point};
+use super::measurements::traced_point;
 use crate::eval::test_materials::preset;
 use crate::eval::{Evaluator, FootprintQuery};
 use crate::scene::direction::direction;
-use glam::{DMat3, DVec3};
 
 /// Under a transfer curve a flat tread hides the driver's slope from the shading but not from the
 /// masking: a tread point where f rises toward the light meets the next riser up, one where it
@@ -25,7 +24,6 @@ use glam::{DMat3, DVec3};
 #[test]
 #[ignore = "a measurement, prints a table"]
 fn transfer_conditioned_visibility() {
-    use crate::microfacet::slopes::normal_of;
     const FB: usize = 24;
     const TB: usize = 8;
     let n_points = 400_000;
@@ -49,49 +47,51 @@ fn transfer_conditioned_visibility() {
         let mut rng = 11u64;
         let mut clears = Vec::with_capacity(n_points);
         for _ in 0..n_points {
-            let Some(FrontPoint { x, f, h, grad, u }) = front_point(s, wo, &mut rng) else {
+            let Some(t) = traced_point(&p, wo, wi, &mut rng) else {
                 continue;
             };
-            let (_, gf) = s.driver.value_and_gradient(x);
-            let n = normal_of(grad);
-            let pt = DVec3::new(x.x, x.y, h);
-            let seen = s.sees(pt, wo);
-            // Self-shadowing is the clamped cosine's (L lit = L unlit there): `lit` asks only
-            // whether other surface blocks the sun, for the points that face it.
-            let faces = n.dot(wi) > 0.0;
-            let clear = faces && s.sees(pt, wi);
-            let lit = seen && clear;
-            let l1 = p.shade_hit(f, n, wo, wi, &DMat3::IDENTITY, || true);
-            let l0 = p.shade_hit(f, n, wo, wi, &DMat3::IDENTITY, || false);
-            pts.push((u, f, gf.dot(d), seen, faces, lit, l1, l0));
-            clears.push(clear);
+            let lit = t.seen && t.clear;
+            pts.push((
+                t.u,
+                t.f,
+                t.grad_f.dot(d),
+                t.seen,
+                t.faces,
+                lit,
+                t.lit,
+                t.unlit,
+            ));
+            clears.push(t.clear);
         }
         let sd_f = (pts.iter().map(|p| p.1 * p.1).sum::<f64>() / pts.len() as f64).sqrt();
         let sd_t = (pts.iter().map(|p| p.2 * p.2).sum::<f64>() / pts.len() as f64).sqrt();
         let fbin = |f: f64| (((f / sd_f + 3.0) / 6.0 * FB as f64).max(0.0) as usize).min(FB - 1);
         let tbin = |t: f64| (((t / sd_t + 2.0) / 4.0 * TB as f64).max(0.0) as usize).min(TB - 1);
-        // Empirical visibilities on a set of bins: (all, seen, seen and facing the sun, lit)
-        // projected-area weighted.
-        let model = |key: &dyn Fn(f64, f64) -> usize, bins: usize| {
-            let mut acc = vec![[0.0f64; 4]; bins];
-            for (u, f, t, seen, faces, lit, ..) in &pts {
+        // Empirical visibilities on a set of bins, projected-area weighted: P(seen | bin), and
+        // P(lit | seen, facing the sun, bin) or, `independent`, P(clear | facing the sun, bin)
+        // over every point (seen or not), as if seen and lit were independent given the bin.
+        let fitted = |key: &dyn Fn(f64, f64) -> usize, bins: usize, independent: bool| {
+            // (all, seen, seen and facing, lit, facing, clear)
+            let mut acc = vec![[0.0f64; 6]; bins];
+            for ((u, f, t, seen, faces, lit, ..), clear) in pts.iter().zip(&clears) {
                 let a = &mut acc[key(*f, *t)];
-                a[0] += u;
-                if *seen {
-                    a[1] += u;
-                    if *faces {
-                        a[2] += u;
-                    }
-                    if *lit {
-                        a[3] += u;
+                let flags = [true, *seen, *seen && *faces, *lit, *faces, *clear];
+                for (a, on) in a.iter_mut().zip(flags) {
+                    if on {
+                        *a += u;
                     }
                 }
             }
             let (mut num, mut den) = ([0.0; 3], 0.0);
             for (u, f, t, _, _, _, l1, l0) in &pts {
                 let a = acc[key(*f, *t)];
-                let g = if a[0] > 0.0 { a[1] / a[0] } else { 0.0 };
-                let v = if a[2] > 0.0 { a[3] / a[2] } else { 0.0 };
+                let ratio = |x: f64, y: f64| if y > 0.0 { x / y } else { 0.0 };
+                let g = ratio(a[1], a[0]);
+                let v = if independent {
+                    ratio(a[5], a[4])
+                } else {
+                    ratio(a[3], a[2])
+                };
                 for k in 0..3 {
                     num[k] += u * g * (v * l1[k] + (1.0 - v) * l0[k]);
                 }
@@ -99,37 +99,8 @@ fn transfer_conditioned_visibility() {
             }
             num.map(|x| x / den)
         };
-        // Seen and lit independent given the bin: P(seen | bin)·P(clear | bin), P(clear) over
-        // every point that faces the sun (seen or not).
-        let independent = |key: &dyn Fn(f64, f64) -> usize, bins: usize| {
-            let mut acc = vec![[0.0f64; 4]; bins];
-            for ((u, f, t, seen, faces, ..), clear) in pts.iter().zip(&clears) {
-                let a = &mut acc[key(*f, *t)];
-                a[0] += u;
-                if *seen {
-                    a[1] += u;
-                }
-                if *faces {
-                    a[2] += u;
-                    if *clear {
-                        a[3] += u;
-                    }
-                }
-            }
-            let (mut num, mut den) = ([0.0; 3], 0.0);
-            for (u, f, t, _, _, _, l1, l0) in &pts {
-                let a = acc[key(*f, *t)];
-                let g = if a[0] > 0.0 { a[1] / a[0] } else { 0.0 };
-                let v = if a[2] > 0.0 { a[3] / a[2] } else { 0.0 };
-                for k in 0..3 {
-                    num[k] += u * g * (v * l1[k] + (1.0 - v) * l0[k]);
-                }
-                den += u * g;
-            }
-            num.map(|x| x / den)
-        };
-        let independent_value = independent(&|f, _| fbin(f), FB);
-        let independent_slope = independent(&|f, t| fbin(f) * TB + tbin(t), FB * TB);
+        let independent_value = fitted(&|f, _| fbin(f), FB, true);
+        let independent_slope = fitted(&|f, t| fbin(f) * TB + tbin(t), FB * TB, true);
         let (mut t, mut tw) = ([0.0; 3], 0.0);
         for (u, _, _, seen, _, lit, l1, l0) in &pts {
             if *seen {
@@ -140,8 +111,8 @@ fn transfer_conditioned_visibility() {
             }
         }
         let t = t.map(|v| v / tw);
-        let value_only = model(&|f, _| fbin(f), FB);
-        let value_slope = model(&|f, t| fbin(f) * TB + tbin(t), FB * TB);
+        let value_only = fitted(&|f, _| fbin(f), FB, false);
+        let value_slope = fitted(&|f, t| fbin(f) * TB + tbin(t), FB * TB, false);
         let rel = |v: [f64; 3], r: [f64; 3]| {
             (0..3)
                 .map(|k| 100.0 * (v[k] - r[k]) / r[k])

@@ -3,11 +3,10 @@
 //! lodestone-core -- --ignored --nocapture transfer_conditioned_masking_prototype`; the views'
 //! form is [`crate::eval::transfer_masking_table`]).
 
-use super::measurements::{FrontPoint, front_point};
+use super::measurements::traced_point;
 use crate::eval::test_materials::preset;
 use crate::eval::{Evaluator, FootprintQuery};
 use crate::scene::direction::direction;
-use glam::{DMat3, DVec3};
 
 /// Masking under a transfer curve, conditioned on the start's driver value f₀ and its slope t
 /// along the ray's azimuth: the prototype of [`crate::microfacet::slope_masking`] with the ray
@@ -138,7 +137,6 @@ impl BarrierMasking {
 #[test]
 #[ignore = "a measurement, prints a table"]
 fn transfer_conditioned_masking_prototype() {
-    use crate::microfacet::slopes::normal_of;
     let n_points = 200_000;
     for (name, view, light, az) in [
         ("terraces", 60.0, 60.0, 180.0),
@@ -150,7 +148,6 @@ fn transfer_conditioned_masking_prototype() {
         let mut m = preset(name);
         m.brdf.specular = 0.0;
         let p = Evaluator::new(&m).expect("prepared");
-        let s = &p.surface;
         let wo = direction(f64::to_radians(view), 0.0);
         let wi = direction(f64::to_radians(light), f64::to_radians(az));
         let (d_o, d_i) = (
@@ -196,17 +193,11 @@ fn transfer_conditioned_masking_prototype() {
             crate::microfacet::masking_shadowing::azimuth_difference(wo, wi),
         );
         for _ in 0..n_points {
-            let Some(FrontPoint { x, f, h, grad, u }) = front_point(s, wo, &mut rng) else {
+            let Some(t) = traced_point(&p, wo, wi, &mut rng) else {
                 continue;
             };
-            let (_, gf) = s.driver.value_and_gradient(x);
-            let n = normal_of(grad);
-            let pt = DVec3::new(x.x, x.y, h);
-            let seen = s.sees(pt, wo);
-            let faces = n.dot(wi) > 0.0;
-            let clear = faces && s.sees(pt, wi);
-            let l1 = p.shade_hit(f, n, wo, wi, &DMat3::IDENTITY, || true);
-            let l0 = p.shade_hit(f, n, wo, wi, &DMat3::IDENTITY, || false);
+            let (f, gf, n, u) = (t.f, t.grad_f, t.normal, t.u);
+            let (seen, faces, clear, l1, l0) = (t.seen, t.faces, t.clear, t.lit, t.unlit);
             let go = masking.at(f, gf.dot(d_o));
             let gi = if faces {
                 shadowing.at(f, gf.dot(d_i))
@@ -261,9 +252,6 @@ fn transfer_conditioned_masking_prototype() {
         let err_table = (0..3)
             .map(|k| 100.0 * (vl[k] / vw - tl[k] / tw) / (tl[k] / tw))
             .fold(0.0f64, |a, e| if e.abs() > a.abs() { e } else { a });
-        eprintln!(
-            "    per point with the views' table and G2 combination: {err_table:+.2}% against the point truth"
-        );
         let cells: Vec<String> = bins
             .iter()
             .map(|b| {
@@ -286,13 +274,16 @@ fn transfer_conditioned_masking_prototype() {
             })
             .collect();
         eprintln!(
-            "    seen and lit, cosine-weighted, truth/per point/bin formula: {}",
-            jc.join(" | ")
-        );
-        eprintln!(
             "{name:9} view {view} light {light}/{az} (specular 0): conditioned model {err:+.2}% against the point truth\n    \
              by f in (−∞,−1.5) … (1.5,∞), step 0.5: P(seen) truth/model/table, P(clear | faces the sun) truth/model/table: {}",
             cells.join(" | ")
+        );
+        eprintln!(
+            "    per point with the views' table and G2 combination: {err_table:+.2}% against the point truth"
+        );
+        eprintln!(
+            "    seen and lit, cosine-weighted, truth/per point/bin formula: {}",
+            jc.join(" | ")
         );
     }
 }
