@@ -2,7 +2,7 @@
 //! textures as they arrive, and error heat maps against the ground truth.
 
 use super::truth_maps::truth_map;
-use super::worker::{Event, Frame, Request};
+use super::worker::{Event, Frame, MAX_RESTARTS, Request, Worker};
 use super::{DeviceStatus, EditorApp, ErrorShown, Shown, TruthHeatShown};
 use lodestone_render::error_map::{error_heat, error_stats, heat_gradient};
 use lodestone_render::truth_noise::{BlockErrors, TruthEstimate};
@@ -28,6 +28,7 @@ impl EditorApp {
                     self.device = DeviceStatus::Ready(adapter);
                 }
                 Event::NoAdapter(e) => self.device = DeviceStatus::Failed(e),
+                Event::Stopped(e) => self.restart_worker(ctx, &e),
                 Event::MaterialError(e) => self.material_error = Some(e),
                 Event::RenderError(e) => self.notify(ctx, e, true),
                 Event::Frame(f) => {
@@ -52,6 +53,29 @@ impl EditorApp {
                 }
             }
         }
+    }
+
+    /// The render thread stopped on a panic: start a new one and ask it for the views again (at
+    /// most [`MAX_RESTARTS`] times), or say the renderer failed.
+    pub(super) fn restart_worker(&mut self, ctx: &egui::Context, why: &str) {
+        if self.restarts >= MAX_RESTARTS {
+            self.device = DeviceStatus::Failed(format!(
+                "the renderer stopped {} times (last: {why})",
+                self.restarts + 1
+            ));
+            return;
+        }
+        self.restarts += 1;
+        let repaint = ctx.clone();
+        self.worker = Worker::spawn(self.device_source, move || repaint.request_repaint());
+        self.device = DeviceStatus::Starting;
+        // Nothing of the old thread's work survives: the next frame asks for everything again.
+        self.last_request = None;
+        self.notify(
+            ctx,
+            format!("The renderer stopped ({why}); restarted it"),
+            true,
+        );
     }
 
     /// Heat maps of each shown mode against the latest ground truth of the same size.

@@ -143,6 +143,10 @@ pub struct EditorApp {
     inspector: Inspector,
     sweep: Option<Sweep>,
     worker: Worker,
+    /// Where the worker's device comes from (for a restart).
+    device_source: DeviceSource,
+    /// Render threads started again after one stopped on a panic.
+    restarts: u32,
     device: DeviceStatus,
     material_error: Option<String>,
     shown: HashMap<ViewMode, Shown>,
@@ -221,6 +225,7 @@ impl EditorApp {
         } else {
             options.device
         };
+        let device_source = device;
         let worker = Worker::spawn(device, move || ctx.request_repaint());
         let mut app = Self {
             inspector: Inspector::new(&material),
@@ -229,6 +234,8 @@ impl EditorApp {
             view: stored.view.clone(),
             sweep: None,
             worker,
+            device_source,
+            restarts: 0,
             device: DeviceStatus::Starting,
             material_error: None,
             shown: HashMap::new(),

@@ -204,6 +204,40 @@ fn no_adapter(h: &Harness<'static, EditorApp>) -> bool {
     matches!(h.state().device, DeviceStatus::Failed(_))
 }
 
+/// A render thread that stops on a panic (a driver's, as wgpu's GL backend does when it cannot
+/// take its context lock in time on a loaded machine) is started again: the window says so, asks
+/// for its views again and settles; it does not wait forever for frames that will never come.
+#[test]
+fn a_stopped_renderer_is_restarted_and_the_views_come_back() {
+    let mut h = harness(640.0, 400.0, DeviceSource::Headless);
+    if !device_ready(
+        &mut h,
+        "a_stopped_renderer_is_restarted_and_the_views_come_back",
+    ) {
+        return;
+    }
+    h.state_mut().view.max_scale = 1.0 / 16.0;
+    settle(&mut h, Duration::from_secs(240));
+    let (_, mut req) = h.state().last_request.clone().expect("a request");
+    req.generation = super::worker::PANIC_GENERATION;
+    h.state().worker.request(req);
+    let t0 = Instant::now();
+    while h.state().restarts == 0 {
+        assert!(t0.elapsed() < Duration::from_secs(60), "no restart");
+        h.step();
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let notice = h.state().notice.clone().expect("a notice");
+    assert!(
+        notice.error && notice.text.contains("injected"),
+        "{}",
+        notice.text
+    );
+    settle(&mut h, Duration::from_secs(240));
+    assert!(matches!(h.state().device, DeviceStatus::Ready(_)));
+    assert_eq!(h.state().restarts, 1);
+}
+
 #[test]
 fn loads_a_preset_and_edits_undo_redo() {
     let mut h = harness(1600.0, 900.0, DeviceSource::Headless);

@@ -102,6 +102,28 @@ pub enum Event {
     Frame(Frame),
     /// Rendering failed.
     RenderError(String),
+    /// The render thread stopped on a panic (a driver's, e.g. wgpu's GL backend when it cannot
+    /// take its context lock in time on a loaded machine): the message. Nothing more will come
+    /// from this worker; the window starts a new one ([`MAX_RESTARTS`]).
+    Stopped(String),
+}
+
+/// How many times the window starts a new render thread after one stopped on a panic, before it
+/// says the renderer failed.
+pub const MAX_RESTARTS: u32 = 3;
+
+/// Tests: a request of this generation makes the worker panic, as a driver would (a value the
+/// window never reaches, and no state shared between tests).
+#[cfg(test)]
+pub(crate) const PANIC_GENERATION: u64 = u64::MAX - 7;
+
+/// The message of a caught panic.
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| (*s).to_owned())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic without a message".to_owned())
 }
 
 /// Handle on the worker thread.
@@ -163,15 +185,24 @@ impl Worker {
                 };
                 match ctx {
                     Ok(ctx) => {
-                        let t0 = Instant::now();
-                        let renderer = Renderer::new(ctx);
-                        log::info!("view pipeline compiled in {:.1?}", t0.elapsed());
-                        let ctx = renderer.context();
-                        send(Event::Ready {
-                            adapter: ctx.describe(),
-                            software: ctx.is_software(),
-                        });
-                        State::new(renderer).run(&req_rx, &send);
+                        // A panic below (in the driver, most likely) must not leave the window
+                        // waiting for frames that will never come: say so, and end the thread.
+                        let served = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                            let t0 = Instant::now();
+                            let renderer = Renderer::new(ctx);
+                            log::info!("view pipeline compiled in {:.1?}", t0.elapsed());
+                            let ctx = renderer.context();
+                            send(Event::Ready {
+                                adapter: ctx.describe(),
+                                software: ctx.is_software(),
+                            });
+                            State::new(renderer).run(&req_rx, &send);
+                        }));
+                        if let Err(payload) = served {
+                            let msg = panic_message(payload.as_ref());
+                            log::error!("the render thread stopped: {msg}");
+                            send(Event::Stopped(msg));
+                        }
                     }
                     Err(e) => send(Event::NoAdapter(e)),
                 }
@@ -366,6 +397,10 @@ impl State {
         rx: &Receiver<Request>,
         send: &dyn Fn(Event),
     ) -> Result<Option<Request>, ()> {
+        #[cfg(test)]
+        if req.generation == PANIC_GENERATION {
+            panic!("injected for a test");
+        }
         if !self.upload(
             &req.material,
             &req.image,
@@ -669,6 +704,27 @@ mod tests {
             max_scale: 1.0,
             adaptive_truth: false,
         }
+    }
+
+    /// A panic while serving (as a driver's) ends the thread with `Stopped` and its message,
+    /// instead of leaving the window waiting; dropping the worker then joins it cleanly.
+    #[test]
+    fn a_panic_in_the_render_thread_is_reported() {
+        let w = Worker::spawn(DeviceSource::Headless, || {});
+        match w.wait(Duration::from_secs(60)) {
+            Some(Event::Ready { .. }) => {}
+            Some(Event::NoAdapter(e)) => {
+                lodestone_tests::skip("the worker panic test", e);
+                return;
+            }
+            other => panic!("unexpected {other:?}"),
+        }
+        w.request(request(PANIC_GENERATION, 1));
+        match w.wait(Duration::from_secs(60)) {
+            Some(Event::Stopped(msg)) => assert!(msg.contains("injected"), "{msg}"),
+            other => panic!("unexpected {other:?}"),
+        }
+        drop(w);
     }
 
     /// The worker renders every requested mode, refines to full size, and accumulates exactly
