@@ -47,11 +47,12 @@ use crate::microfacet::slopes::normal_of;
 use crate::microfacet::visible_slopes::slope_rule;
 use glam::{DMat3, DVec2, DVec3};
 
+use std::f64::consts::FRAC_1_PI;
+
 /// n of the polar rule (n² nodes) over a bin's slopes when its masking is conditioned on the
 /// driver's slope ([`crate::eval::transfer_masking_table`]): the visibility turns within 1σ of
 /// the driver's slope over a tread, where the shading alone would need few nodes.
 pub const CONDITIONED_SLOPE_POINTS: usize = 8;
-use std::f64::consts::FRAC_1_PI;
 
 /// What a bin of the driver's value contributes: its mean g′, the root mean square of g′ and the
 /// mean point colour.
@@ -166,6 +167,7 @@ impl Evaluator {
             .transfer_masking
             .as_ref()
             .map(|t| TransferRays::new(t, d, (wo, wi), sun_lit, sigma_h, m.filtering.correlation));
+        let conditioned_points = points.max(CONDITIONED_SLOPE_POINTS);
         let (mut above_o, mut above) = (0.0, 0.0);
         let (mut num, mut den) = ([0.0f64; 3], 0.0f64);
         for &(lo, hi, bin) in bins.iter().rev() {
@@ -179,73 +181,70 @@ impl Evaluator {
             let (s, s_o): (SlopeShading, f64) =
                 self.visible_shading_sums(mean, &cov, cfg.wo, cfg.wi, frame, points);
             let c = m.terms.affine(bin.color);
-            // Smith's bin, or the conditioned one blended with it by the footprint's far weight.
-            let mut parts = vec![(1.0, (w1, w2), (s, s_o), (s, s_o))];
-            if let Some(rays) = &conditioned {
-                let x = rays.value_at(0.5 * (lo + hi));
-                let (l11, l21, l22) =
-                    cholesky(d.gradient_cov.xx, d.gradient_cov.xy, d.gradient_cov.yy);
-                let (mut s1, mut s1o, mut s2, mut s2o) =
-                    (SlopeShading::default(), 0.0, SlopeShading::default(), 0.0);
-                for (z, wz) in slope_rule(points.max(CONDITIONED_SLOPE_POINTS)) {
-                    let tf = DVec2::new(l11 * z.x, l21 * z.x + l22 * z.y);
-                    let sl = mean + tf * (sigma_h * bin.rms_deriv);
-                    let u = (cfg.wo.z - sl.x * cfg.wo.x - sl.y * cfg.wo.y).max(0.0);
-                    if u == 0.0 {
-                        continue;
-                    }
-                    let shade = self.point_shading(normal_of(sl), cfg.wi, frame);
-                    let (go, g2) = rays.node_visibility(x, *z);
-                    s1.add(&shade, wz * u * go);
-                    s1o += wz * u * go;
-                    s2.add(&shade, wz * u * g2);
-                    s2o += wz * u * g2;
-                }
-                // The lobe's facets are not the average facet: its visibility is G2 over the
-                // driver slopes of the lobe's posterior (the facets near the half vector), on the
-                // same rule; the average where the bin has no slope to select them by.
-                let scale = sigma_h * bin.rms_deriv;
-                let lobe_vis = half_vector_posterior(mean, &cov, cfg.wo, cfg.wi, m.brdf.roughness)
-                    .filter(|_| scale > 1e-12 && sun_lit)
-                    .map(|(pm, pc)| {
-                        let tm = (pm - mean) / scale;
-                        let (a11, a21, a22) = cholesky(pc.xx, pc.xy, pc.yy);
-                        let (mut acc, mut wsum) = (0.0, 0.0);
-                        for (z, wz) in slope_rule(points.max(CONDITIONED_SLOPE_POINTS)) {
-                            let tf = tm + DVec2::new(a11 * z.x, a21 * z.x + a22 * z.y) / scale;
-                            acc += wz * rays.gradient_visibility(x, tf).1;
-                            wsum += wz;
-                        }
-                        if wsum > 0.0 { acc / wsum } else { 0.0 }
-                    });
-                let width = hi - lo;
-                parts[0].0 = 1.0 - rays.far();
-                parts.push((
-                    rays.far(),
-                    (width, width),
-                    (s1, s1o),
-                    (s2, lobe_vis.map_or(s2o, |v| v * s_o)),
-                ));
-            }
-            for (share, (w1, w2), (s1, s1o), (s2, s2o)) in parts {
-                if share == 0.0 {
-                    continue;
-                }
+            let lobe = sun_lit.then(|| self.specular_lobes(mean, &cov, cfg.wo, cfg.wi));
+            // One part of the bin, weighted by `share`: masses w1 (seen) and w2 (seen and lit),
+            // the shading sums weighted by the masking (environment) and by the joint term
+            // (sun), and the lobe's visible mass.
+            let mut add = |share: f64,
+                           (w1, w2): (f64, f64),
+                           s1: &SlopeShading,
+                           s1o: f64,
+                           s2: &SlopeShading,
+                           lobe_mass: f64| {
                 den += share * w1 * s1o;
-                let (v, spec) = if sun_lit {
-                    let lobe = self.specular_lobes(mean, &cov, cfg.wo, cfg.wi);
-                    (share * w2 * sun, lobe.map(|l| l * s2o))
-                } else {
-                    (0.0, [0.0; 3])
-                };
-                let tint = specular_tint(&weights, &c, &s2);
+                let v = if sun_lit { share * w2 * sun } else { 0.0 };
+                let spec = lobe.map_or([0.0; 3], |l| l.map(|l| l * lobe_mass));
+                let tint = specular_tint(&weights, &c, s2);
                 for ch in 0..3 {
                     let kd = kd * weights.kd[ch];
                     num[ch] += v
                         * (kd * (c.a[ch] * s2.cos + c.k[ch] * s2.cs_cos[ch]) + spec[ch] * tint[ch])
                         + share * w1 * kd * (c.a[ch] * s1.env[ch] + c.k[ch] * s1.cs_env[ch]);
                 }
+            };
+            let Some(rays) = &conditioned else {
+                add(1.0, (w1, w2), &s, s_o, &s, s_o);
+                continue;
+            };
+            // Smith's bin blended with the conditioned one by the footprint's far weight.
+            if rays.far() < 1.0 {
+                add(1.0 - rays.far(), (w1, w2), &s, s_o, &s, s_o);
             }
+            let x = rays.value_at(0.5 * (lo + hi));
+            let (mut s1, mut s1o, mut s2, mut s2o) =
+                (SlopeShading::default(), 0.0, SlopeShading::default(), 0.0);
+            for (z, wz) in slope_rule(conditioned_points) {
+                let sl = mean + rays.gradient_at(*z) * (sigma_h * bin.rms_deriv);
+                let u = (cfg.wo.z - sl.x * cfg.wo.x - sl.y * cfg.wo.y).max(0.0);
+                if u == 0.0 {
+                    continue;
+                }
+                let shade = self.point_shading(normal_of(sl), cfg.wi, frame);
+                let (go, g2) = rays.node_visibility(x, *z);
+                s1.add(&shade, wz * u * go);
+                s1o += wz * u * go;
+                s2.add(&shade, wz * u * g2);
+                s2o += wz * u * g2;
+            }
+            // The lobe's facets are not the average facet: its visibility is G2 over the driver
+            // slopes of the lobe's posterior (the facets near the half vector), on the same rule;
+            // the average where the bin has no slope to select them by.
+            let scale = sigma_h * bin.rms_deriv;
+            let lobe_mass = half_vector_posterior(mean, &cov, cfg.wo, cfg.wi, m.brdf.roughness)
+                .filter(|_| scale > 1e-12 && sun_lit)
+                .map_or(s2o, |(pm, pc)| {
+                    let tm = (pm - mean) / scale;
+                    let (a11, a21, a22) = cholesky(pc.xx, pc.xy, pc.yy);
+                    let (mut acc, mut wsum) = (0.0, 0.0);
+                    for (z, wz) in slope_rule(conditioned_points) {
+                        let tf = tm + DVec2::new(a11 * z.x, a21 * z.x + a22 * z.y) / scale;
+                        acc += wz * rays.gradient_visibility(x, tf).1;
+                        wsum += wz;
+                    }
+                    if wsum > 0.0 { acc / wsum * s_o } else { 0.0 }
+                });
+            let width = hi - lo;
+            add(rays.far(), (width, width), &s1, s1o, &s2, lobe_mass);
         }
         if !(den > 0.0) {
             return [0.0; 3];

@@ -385,6 +385,13 @@ impl TransferRays {
         (go, g2)
     }
 
+    /// The driver gradient `L z` of the standard node `z` (L the Cholesky factor of the
+    /// footprint's unresolved driver-gradient covariance).
+    pub fn gradient_at(&self, z: DVec2) -> DVec2 {
+        let (l11, l21, l22) = self.chol;
+        DVec2::new(l11 * z.x, l21 * z.x + l22 * z.y)
+    }
+
     /// [`TransferRays::node_visibility`] of a start whose driver gradient is `grad` (driver
     /// units; a direction the footprint's gradient has no spread in reads its mean, 0).
     pub fn gradient_visibility(&self, x: f64, grad: DVec2) -> (f64, f64) {
