@@ -10,7 +10,12 @@
 //! azimuth ([`TABLE_AZIMUTHS`] over [0, π)) and `ν = μ/(σ_h σ_t)` ([`TABLE_NUS`] nodes, linear in
 //! ln ν). The process is the driver's whole (far field): the barrier is the curve at the
 //! driver's absolute value, which a footprint's unresolved part alone does not know, so the
-//! views blend toward Smith's as the footprint resolves the driver ([`far_weight`]).
+//! bins blend toward Smith's as the footprint resolves the driver ([`far_weight`]).
+//!
+//! **A CPU prototype.** [`crate::eval::Evaluator::new`] does not build the table and the views
+//! keep Smith's bins; the measurements set [`crate::eval::Evaluator::transfer_masking`] to compare
+//! (docs/design.md, "Transfer curves: masking that knows the driver's slope", has the full grid
+//! and why it is not the default yet).
 
 use crate::driver::noise::SumOfSines;
 use crate::eval::slope_masking_table::{
