@@ -3,8 +3,9 @@
 //!
 //! The surface is `h = σ_h·g(f)` over a Gaussian driver f. Along a horizontal direction d the
 //! driver is a stationary Gaussian process; in units where it has unit variance and unit slope
-//! variance ([`crate::microfacet::slope_masking::LineProcess`]: x = f/σ_f, τ the distance over `σ_f/σ_t`, σ_t the driver's slope
-//! deviation along d) the ray `h₀ + μs` meets the surface where x crosses the **barrier**
+//! variance ([`crate::microfacet::slope_masking::LineProcess`]: x = f/σ_f, τ the distance over
+//! `σ_f/σ_t`, σ_t the driver's slope deviation along d) the ray `h₀ + μs` meets the surface where
+//! x crosses the **barrier**
 //! `b(τ) = G⁻¹(G(x₀) + ντ)`, with `G(x) = g(σ_f x)/σ_f` and `ν = μ/(σ_h σ_t)` (the ν of
 //! [`crate::microfacet::slope_masking`]: under the identity transfer the barrier is the ray
 //! `x₀ + ντ` and everything here is that module's `G1`). The barrier's slope is `ν/G′(b)`:
