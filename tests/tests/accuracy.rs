@@ -1,6 +1,6 @@
 //! #17's accuracy grid in test-sized form: every preset of the library, far patch, views 0°, 60°
-//! and 85° × the light at the normal and 30° on the view's side and opposite; the filtered model
-//! against the ray-traced ground truth (20 000 seeded rays: deterministic).
+//! and 85° × the light at the normal, 30° and 60° on the view's side and opposite; the filtered
+//! model against the ray-traced ground truth (20 000 seeded rays: deterministic).
 //!
 //! The error that counts is what lies beyond the truth's own noise, `(|F − T| − 3·s.e.)⁺ / T`,
 //! worst channel. The goal of #17 is ≤ 1% up to 60° and ≤ 4% at 85°. Where a preset does not meet
@@ -19,8 +19,16 @@ const RAYS: usize = 20_000;
 /// Views from the normal (degrees).
 const VIEWS: [f64; 3] = [0.0, 60.0, 85.0];
 
-/// Lights: (angle from the normal, azimuth; the view's azimuth is 0), degrees.
-const LIGHTS: [(f64, f64); 3] = [(0.0, 0.0), (30.0, 0.0), (30.0, 180.0)];
+/// Lights: (angle from the normal, azimuth; the view's azimuth is 0), degrees. The 60° lights are
+/// where the transfer curves miss (docs/design.md, "Transfer curves: masking that knows the
+/// driver's slope").
+const LIGHTS: [(f64, f64); 5] = [
+    (0.0, 0.0),
+    (30.0, 0.0),
+    (30.0, 180.0),
+    (60.0, 0.0),
+    (60.0, 180.0),
+];
 
 /// Open shortfalls of #17: (preset file, view, light angle, light azimuth, largest excess allowed),
 /// measured 2026-12-03 (the excess ×1.1). Cobblestones at 85° with the light at the normal: the
@@ -30,7 +38,23 @@ const LIGHTS: [(f64, f64); 3] = [(0.0, 0.0), (30.0, 0.0), (30.0, 180.0)];
 /// docs/design.md). (Snow under sky at 85°, 5–6% beyond the truth's noise with Smith's masking,
 /// met the goal once the masking was conditioned on height and slope jointly: 1.4–1.5%. Terraces, 1.3–1.6% at 0° and
 /// 60° with the transfer mixture's 8 bins, met the goal once the mixture had 16: 0.6–0.9%.)
-const KNOWN: &[(&str, f64, f64, f64, f64)] = &[("cobblestones.ron", 85.0, 0.0, 0.0, 0.087)];
+///
+/// With the light at 60° (measured 2026-12-04, ×1.1): the transfer curves' value bins keep Smith's
+/// height-only masking, which misses the driver's slope hidden under a tread (terraces with the
+/// light opposite, sponge at 60° with it along the view: the CPU prototype takes both to within
+/// the goal), and their one Gaussian per bin is thin under a grazing lobe (along the view at
+/// 85°); docs/design.md, "Transfer curves: masking that knows the driver's
+/// slope", has the cause and a CPU prototype that takes most of it. Snake-skin at 60° with the
+/// light opposite is session 21's 45–60° joint-masking shortfall.
+const KNOWN: &[(&str, f64, f64, f64, f64)] = &[
+    ("cobblestones.ron", 85.0, 0.0, 0.0, 0.087),
+    ("snake-skin.ron", 60.0, 60.0, 180.0, 0.0151),
+    ("sponge.ron", 60.0, 60.0, 0.0, 0.0243),
+    ("sponge.ron", 85.0, 60.0, 0.0, 0.1323),
+    ("terraces.ron", 60.0, 60.0, 180.0, 0.0532),
+    ("terraces.ron", 85.0, 60.0, 0.0, 0.0537),
+    ("terraces.ron", 85.0, 60.0, 180.0, 0.1411),
+];
 
 /// The goal of #17 at a view angle.
 fn goal(view_deg: f64) -> f64 {
