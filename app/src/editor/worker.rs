@@ -706,19 +706,27 @@ mod tests {
         }
     }
 
+    /// A headless worker whose device is up, or `None` (logged as skipped as `test`) without an
+    /// adapter.
+    fn ready_worker(test: &str) -> Option<Worker> {
+        let w = Worker::spawn(DeviceSource::Headless, || {});
+        match w.wait(Duration::from_secs(60)) {
+            Some(Event::Ready { .. }) => Some(w),
+            Some(Event::NoAdapter(e)) => {
+                lodestone_tests::skip(test, e);
+                None
+            }
+            other => panic!("unexpected {other:?}"),
+        }
+    }
+
     /// A panic while serving (as a driver's) ends the thread with `Stopped` and its message,
     /// instead of leaving the window waiting; dropping the worker then joins it cleanly.
     #[test]
     fn a_panic_in_the_render_thread_is_reported() {
-        let w = Worker::spawn(DeviceSource::Headless, || {});
-        match w.wait(Duration::from_secs(60)) {
-            Some(Event::Ready { .. }) => {}
-            Some(Event::NoAdapter(e)) => {
-                lodestone_tests::skip("the worker panic test", e);
-                return;
-            }
-            other => panic!("unexpected {other:?}"),
-        }
+        let Some(w) = ready_worker("the worker panic test") else {
+            return;
+        };
         w.request(request(PANIC_GENERATION, 1));
         match w.wait(Duration::from_secs(60)) {
             Some(Event::Stopped(msg)) => assert!(msg.contains("injected"), "{msg}"),
@@ -731,15 +739,9 @@ mod tests {
     /// the requested truth samples.
     #[test]
     fn serves_every_mode_up_to_full_resolution() {
-        let w = Worker::spawn(DeviceSource::Headless, || {});
-        match w.wait(Duration::from_secs(60)) {
-            Some(Event::Ready { .. }) => {}
-            Some(Event::NoAdapter(e)) => {
-                lodestone_tests::skip("the worker test", e);
-                return;
-            }
-            other => panic!("unexpected {other:?}"),
-        }
+        let Some(w) = ready_worker("the worker test") else {
+            return;
+        };
         w.request(request(7, 3));
         let mut full = Vec::new();
         let mut truth_spp = 0;

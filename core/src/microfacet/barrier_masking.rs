@@ -54,15 +54,29 @@ impl TransferBarrier {
         } else {
             1.0
         };
+        // g and g′ at f: a curve's polynomial built once (`eval` and `derivative` build it per
+        // call), channels 0 and 2 of its moment polynomial.
+        let poly = match transfer {
+            TransferFunction::Curve(c) => Some(c.moment_poly()),
+            TransferFunction::Identity => None,
+        };
+        let g_and_slope = |f: f64| match &poly {
+            Some(p) => {
+                let mut o = [0.0; 4];
+                p.eval(f, &mut o);
+                (o[0], o[2])
+            }
+            None => (f, 1.0),
+        };
         let mut values = Vec::with_capacity(X_SAMPLES);
         let mut slopes = Vec::with_capacity(X_SAMPLES);
         let mut top = f64::NEG_INFINITY;
         for k in 0..X_SAMPLES {
             let x = Self::x_of(k);
-            let v = transfer.eval(sf * x) / sf;
+            let (g, d) = g_and_slope(sf * x);
+            let v = g / sf;
             top = top.max(if v.is_finite() { v } else { top });
             values.push(if top.is_finite() { top } else { 0.0 });
-            let d = transfer.derivative(sf * x);
             slopes.push(if d.is_finite() { d.max(0.0) } else { 0.0 });
         }
         Self { values, slopes }
