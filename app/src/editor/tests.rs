@@ -503,6 +503,14 @@ fn regenerate_app_screenshots() {
         app.view.adaptive_truth = true;
         app.view.truth_display = TruthDisplay::Rays;
     });
+    shoot("predicted-bandwidth", &|h| {
+        // The same grazing adaptive truth, its predicted bandwidth in the truth viewport.
+        let app = h.state_mut();
+        app.view.camera.elevation_deg = 75.0;
+        app.view.camera.distance = 3.0;
+        app.view.adaptive_truth = true;
+        app.view.truth_display = TruthDisplay::PredictedBandwidth;
+    });
     shoot("truth-reconstructed", &|h| {
         // A grazing ground truth of 8 rays a pixel, reconstructed over the windows that are flat
         // within its noise (View → Ground truth shows → image, reconstructed).

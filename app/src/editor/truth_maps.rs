@@ -5,6 +5,7 @@
 use super::view_state::TruthDisplay;
 use super::worker::Frame;
 use lodestone_core::eval::adaptive_window::{WindowOptions, WindowReconstruction};
+use lodestone_core::eval::image_bandwidth::NYQUIST;
 use lodestone_render::LinearImage;
 use lodestone_render::adaptive_truth::reconstruct_truth;
 use lodestone_render::error_map::heat_gradient;
@@ -47,7 +48,13 @@ pub(super) fn truth_map(frame: &Frame, display: TruthDisplay) -> Option<TruthHea
         return reconstruction(frame).map(|(image, _)| TruthHeat { image, max: 0.0 });
     }
     let values = truth_values(frame, display)?;
-    Some(truth_heat(&values, frame.image.width, frame.image.height))
+    let (w, h) = (frame.image.width, frame.image.height);
+    Some(if display == TruthDisplay::PredictedBandwidth {
+        // On Nyquist's fixed scale, so that maps of different views compare.
+        truth_heat_to(&values, w, h, NYQUIST)
+    } else {
+        truth_heat(&values, w, h)
+    })
 }
 
 /// Per pixel of `frame` (a ground truth), the value `display` shows; `None` for the images, or
@@ -76,6 +83,10 @@ pub(super) fn truth_values(frame: &Frame, display: TruthDisplay) -> Option<Vec<O
             let sd = frame.predicted_sd.as_deref()?;
             (sd.len() == n).then(|| sd.iter().map(|v| Some(f64::from(*v))).collect())
         }
+        TruthDisplay::PredictedBandwidth => {
+            let b = frame.predicted_bandwidth.as_deref()?;
+            (b.len() == n).then(|| b.iter().map(|v| Some(f64::from(*v))).collect())
+        }
         TruthDisplay::Cost => {
             let c = frame.cost.as_deref()?;
             (c.len() == n).then(|| c.iter().map(|v| Some(f64::from(*v))).collect())
@@ -102,6 +113,11 @@ pub(super) fn truth_heat(values: &[Option<f64>], w: u32, h: u32) -> TruthHeat {
         .copied()
         .filter(|v| v.is_finite())
         .fold(0.0_f64, f64::max);
+    truth_heat_to(values, w, h, max)
+}
+
+/// [`truth_heat`] on the scale [0, `max`] (values above it at the top).
+fn truth_heat_to(values: &[Option<f64>], w: u32, h: u32, max: f64) -> TruthHeat {
     let g = heat_gradient();
     let pixels = values
         .iter()
@@ -149,6 +165,7 @@ mod tests {
             samples: 2,
             rays: rays.map(Arc::new),
             predicted_sd: Some(Arc::new(vec![0.5; n as usize])),
+            predicted_bandwidth: Some(Arc::new(vec![0.25; n as usize])),
             cost: Some(Arc::new(vec![2.0; n as usize])),
             moments: Some(Arc::new(SampleMoments {
                 width: n,
@@ -185,6 +202,11 @@ mod tests {
         let rays = truth_values(&f, TruthDisplay::Rays).unwrap();
         assert_eq!(rays, vec![Some(2.0), Some(4.0), Some(1.0)]);
         assert!(truth_values(&f, TruthDisplay::Image).is_none());
+        // The predicted bandwidth on Nyquist's fixed scale: 0.25 cycles per pixel is mid-scale.
+        let bw = truth_map(&f, TruthDisplay::PredictedBandwidth).unwrap();
+        assert_eq!(bw.max, NYQUIST);
+        let mid = heat_gradient().sample(0.5);
+        assert!((bw.image.pixels[0][0] - mid[0] as f32).abs() < 1e-6);
         assert_eq!(
             truth_values(&f, TruthDisplay::Cost).unwrap(),
             vec![Some(2.0); 3]

@@ -111,6 +111,8 @@ pub enum TruthDisplay {
     StandardError,
     /// One ray's predicted luminance deviation (what adaptive sampling plans with).
     PredictedDeviation,
+    /// The image's predicted local bandwidth, cycles per pixel [BSSBH13 Sec. 2.2].
+    PredictedBandwidth,
     /// The rays each pixel has.
     Rays,
     /// What one more ray costs per pixel (march steps plus eights of waves summed).
@@ -125,11 +127,12 @@ pub enum TruthDisplay {
 
 impl TruthDisplay {
     /// Every choice.
-    pub const ALL: [Self; 7] = [
+    pub const ALL: [Self; 8] = [
         Self::Image,
         Self::Reconstructed,
         Self::StandardError,
         Self::PredictedDeviation,
+        Self::PredictedBandwidth,
         Self::Rays,
         Self::Cost,
         Self::WindowRadius,
@@ -141,6 +144,7 @@ impl TruthDisplay {
             Self::Image => "image",
             Self::StandardError => "standard error of the mean",
             Self::PredictedDeviation => "predicted ray deviation",
+            Self::PredictedBandwidth => "predicted bandwidth",
             Self::Rays => "rays per pixel",
             Self::Cost => "cost per ray",
             Self::Reconstructed => "image, reconstructed",
@@ -157,6 +161,9 @@ impl TruthDisplay {
             }
             Self::PredictedDeviation => {
                 "σ̂, one truth ray's luminance deviation predicted from the filtered model (Evaluator::predict_truth: visible colour, slopes, sun visibility, specular second moment); adaptive ground truth plans its rays with it [BSSBH13 Sec. 2.4]"
+            }
+            Self::PredictedBandwidth => {
+                "b, how fast the truth's image varies around each pixel, in cycles per pixel, predicted before any ray from the driver's waves through the colour map (its Hermite orders) and the shading's slope response, the cylinder's curvature through the lobe's width, and the pixel filter (Evaluator::predict_bandwidth, BSSBH13 Sec. 2.2). A lattice of step 2^⌊log2(1/2b)⌋ samples it at Nyquist's rate [BSSBH13 Eq. 11]; 0.5 marks an edge (horizon, silhouette)"
             }
             Self::Rays => {
                 "Rays each pixel has: uniform truth gives every pixel the same; adaptive truth gives them in proportion to σ̂ + ½·mean σ̂, pooled with each pixel's measured deviation"

@@ -425,9 +425,9 @@ impl EditorApp {
             && tex.is_some()
         {
             let why = match d {
-                TruthDisplay::PredictedDeviation | TruthDisplay::Cost => {
-                    ": it needs adaptive ground truth (View menu)"
-                }
+                TruthDisplay::PredictedDeviation
+                | TruthDisplay::PredictedBandwidth
+                | TruthDisplay::Cost => ": it needs adaptive ground truth (View menu)",
                 _ => "",
             };
             note(
@@ -582,6 +582,9 @@ fn truth_legend(ui: &Ui, img: Rect, display: TruthDisplay, max: f64) {
             format!("{max:.0}"),
             "window radius, pixels (flat within the truth's noise)",
         ),
+        TruthDisplay::PredictedBandwidth => {
+            (format!("{max:.1}"), "cycles per pixel (0.5: Nyquist)")
+        }
         TruthDisplay::Image | TruthDisplay::Reconstructed => return,
         _ => (format!("{max:.3}"), "σ̂ of one ray's luminance"),
     };

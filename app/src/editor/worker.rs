@@ -70,6 +70,10 @@ pub struct Frame {
     /// The predicted deviation of one truth ray's luminance per pixel that planned them
     /// (`Evaluator::predict_truth`; `None` where nothing was predicted).
     pub predicted_sd: Option<Arc<Vec<f32>>>,
+    /// The image's predicted local bandwidth per pixel, cycles per pixel, that came with that
+    /// prediction (`Evaluator::predict_bandwidth` [BSSBH13 Sec. 2.2]; `None` where nothing was
+    /// predicted).
+    pub predicted_bandwidth: Option<Arc<Vec<f32>>>,
     /// What one more truth ray costs per pixel, in march steps plus eights of waves summed (the
     /// view shader's `work` over the pixel's rays, plus one; `None` for analytic modes).
     pub cost: Option<Arc<Vec<f32>>>,
@@ -442,6 +446,7 @@ impl State {
                             samples: 0,
                             rays: None,
                             predicted_sd: None,
+                            predicted_bandwidth: None,
                             cost: None,
                             moments: None,
                             pass_time: dt,
@@ -508,6 +513,7 @@ impl State {
         };
         let predicted = predicted_deviation(prepared, &req.scene, size);
         let predicted_f32 = Arc::new(predicted.iter().map(|v| *v as f32).collect::<Vec<_>>());
+        let bandwidth = Arc::new(predicted_bandwidth(prepared, &req.scene, size));
         let spp = req.truth_spp.max(1);
         let plan = Progressive {
             predicted: &predicted,
@@ -544,6 +550,7 @@ impl State {
                         samples: mean,
                         rays: Some(Arc::new(rays.to_vec())),
                         predicted_sd: Some(predicted_f32.clone()),
+                        predicted_bandwidth: Some(bandwidth.clone()),
                         cost: Some(Arc::new(cost)),
                         moments: Some(Arc::new(moments)),
                         pass_time: dt,
@@ -609,6 +616,7 @@ impl State {
                         samples: target.samples,
                         rays: None,
                         predicted_sd: None,
+                        predicted_bandwidth: None,
                         cost: Some(Arc::new(costs_f32(
                             &work,
                             &vec![target.samples; work.len()],
@@ -658,6 +666,19 @@ fn predicted_deviation(prepared: &Evaluator, scene: &Scene, (w, h): (u32, u32)) 
         }
     }
     out
+}
+
+/// The image's predicted bandwidth per pixel of a `size` view of `scene` (cycles per pixel of
+/// that view), evaluated at the centres of blocks that leave at most [`PREDICT_SIDE`] a side
+/// (about 22 µs a block here).
+fn predicted_bandwidth(prepared: &Evaluator, scene: &Scene, (w, h): (u32, u32)) -> Vec<f32> {
+    let step = w.max(h).div_ceil(PREDICT_SIDE).max(1);
+    prepared
+        .predict_bandwidth(scene.shape, &scene.camera, (w, h), scene.light, step)
+        .cycles
+        .into_iter()
+        .map(|v| v as f32)
+        .collect()
 }
 
 /// [`ray_costs`] as the frames carry it.
@@ -810,6 +831,11 @@ mod tests {
         let sd = f.predicted_sd.as_deref().expect("its prediction");
         let n = 32 * 24;
         assert_eq!((rays.len(), sd.len()), (n, n));
+        // The predicted bandwidth came with it: the sky 0, the horizon Nyquist's, the rest between.
+        let b = f.predicted_bandwidth.as_deref().expect("its bandwidth");
+        assert_eq!(b.len(), n);
+        assert!(b.iter().all(|v| (0.0..=0.5).contains(v)), "{b:?}");
+        assert!(b.contains(&0.0) && b.contains(&0.5) && b.iter().any(|v| *v > 0.0 && *v < 0.5));
         let total: u32 = rays.iter().sum();
         assert!(total.abs_diff(8 * n as u32) <= 1, "{total} rays");
         // Traced as planned: each pixel's weight is its ray count.

@@ -35,6 +35,7 @@ pub mod cylinder;
 pub mod evaluator;
 pub mod filtered;
 pub mod ground_truth;
+pub mod image_bandwidth;
 pub mod lod_surface;
 pub mod mixture;
 pub mod mixture_bins;
@@ -50,6 +51,8 @@ pub mod transfer_masking_table;
 pub mod truth_prediction;
 pub mod view_independent;
 
+#[cfg(test)]
+mod image_bandwidth_tests;
 #[cfg(test)]
 mod independent;
 #[cfg(test)]
