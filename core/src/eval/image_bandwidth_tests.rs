@@ -19,9 +19,23 @@ use std::f64::consts::TAU;
 /// Energy-weighted second moment of the spectrum of `img` (n × n, mean removed, Hann window),
 /// in pixel axes, cycles per pixel: a direct DFT, row by row then column by column.
 fn measured_moment(img: &[f64], n: usize) -> DMat2 {
-    let mean = img.iter().sum::<f64>() / img.len() as f64;
+    measured_spectrum(img, None, n).0
+}
 
+/// [`measured_moment`] and the spectrum's energy per pixel (the windowed variance), less the
+/// expected power of white noise of per-pixel variance `noise` where given (each bin's power
+/// floored at 0).
+fn measured_spectrum(img: &[f64], noise: Option<&[f64]>, n: usize) -> (DMat2, f64) {
+    let mean = img.iter().sum::<f64>() / img.len() as f64;
     let hann = |i: usize| 0.5 - 0.5 * (TAU * (i as f64 + 0.5) / n as f64).cos();
+    let noise_power: f64 = noise.map_or(0.0, |v| {
+        (0..n * n)
+            .map(|i| (hann(i % n) * hann(i / n)).powi(2) * v[i])
+            .sum()
+    });
+    let window_power: f64 = (0..n * n)
+        .map(|i| (hann(i % n) * hann(i / n)).powi(2))
+        .sum();
     let mut re = vec![0.0; n * n];
     let mut im = vec![0.0; n * n];
     // Rows: F(y, u).
@@ -53,12 +67,13 @@ fn measured_moment(img: &[f64], n: usize) -> DMat2 {
                 if f >= 0.5 { f - 1.0 } else { f }
             };
             let w = DVec2::new(signed(u), signed(v));
-            let p = a * a + b * b;
+            let p = (a * a + b * b - noise_power).max(0.0);
             e += p;
             m += DMat2::from_cols(w * w.x, w * w.y) * p;
         }
     }
-    m * (1.0 / e)
+    let energy = e / (n * n) as f64 / window_power;
+    (m * (1.0 / e), energy)
 }
 
 /// Eigenvalues of a symmetric 2×2 matrix, larger first.
@@ -265,4 +280,95 @@ fn a_view_is_flat_far_away_and_sharp_at_the_horizon() {
             .all(|v| v.is_finite() && (0.0..=NYQUIST).contains(v))
     );
     assert!(c.cycles.contains(&0.0) && c.cycles.iter().any(|v| *v > 0.0 && *v < NYQUIST));
+}
+
+/// BSSBH13's Fig. 12 for Lodestone (a measurement, ignored): per 32 × 32 window of a 128 × 96
+/// view (BSSBH13 used 32 × 32 windows), the predicted bandwidth (energy-weighted over its pixels,
+/// no display floor) against the ground truth's (CPU truth, 64 rays a pixel, masking and
+/// shadowing included; its DFT's power less the truth's own noise). Prints each window, and per
+/// preset and over all windows the correlation and the median ratios of bandwidth and energy.
+#[test]
+#[ignore = "a measurement: predicted against measured bandwidth over views (about a minute)"]
+fn predicted_bandwidth_against_the_truths() {
+    use crate::math::correlation::{pearson, spearman};
+    let (w, h, win, rays) = (128u32, 96u32, 32usize, 64);
+    let (mut xs, mut ys) = (vec![], vec![]);
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        if v.is_empty() {
+            f64::NAN
+        } else {
+            v[v.len() / 2]
+        }
+    };
+    for name in ["default", "dirt-in-crevices", "snake-skin"] {
+        let (mut bw, mut en) = (vec![], vec![]);
+        let ev = Evaluator::new(&preset(name)).unwrap();
+        for (elevation, distance) in [(60.0, 3.0), (75.0, 3.0), (45.0, 1.5)] {
+            let camera = Camera {
+                elevation_deg: elevation,
+                distance,
+                ..Default::default()
+            };
+            let wi = direction(0.6, 1.0);
+            let lifted = ev.surface.clear_camera(&camera);
+            let pixels: Vec<Option<(f64, f64, f64, f64)>> = (0..w * h)
+                .map(|p| {
+                    let px = DVec2::new(f64::from(p % w) + 0.5, f64::from(p / w) + 0.5);
+                    let (_, cov) = lifted.plane_footprint(px, w, h)?;
+                    let ray = lifted.ray(px, w, h);
+                    let (cfg, _) = ev.pixel_query(ray.origin, ray.dir, wi, Footprint { cov })?;
+                    let (s, _) = ev.radiance_spectrum(&cfg, &DMat3::IDENTITY, 0.0);
+                    let b = s.cycles_per_pixel(&cfg.footprint, 0.0);
+                    let e = ev.ground_truth(&cfg, rays, u64::from(p) + 1);
+                    let lum = |v: [f64; 3]| (0..3).map(|k| LUMINANCE[k] * v[k]).sum::<f64>();
+                    Some((s.energy, b, lum(e.mean), lum(e.std_error).powi(2)))
+                })
+                .collect();
+            for wy in 0..(h as usize / win) {
+                for wx in 0..(w as usize / win) {
+                    let ids: Vec<usize> = (0..win * win)
+                        .map(|i| (wy * win + i / win) * w as usize + wx * win + i % win)
+                        .collect();
+                    let Some(px): Option<Vec<_>> = ids.iter().map(|i| pixels[*i]).collect() else {
+                        continue;
+                    };
+                    let energy: f64 = px.iter().map(|p| p.0).sum();
+                    let predicted =
+                        (px.iter().map(|p| p.0 * p.1 * p.1).sum::<f64>() / energy).sqrt();
+                    let img: Vec<f64> = px.iter().map(|p| p.2).collect();
+                    let noise: Vec<f64> = px.iter().map(|p| p.3).collect();
+                    let (m, e) = measured_spectrum(&img, Some(&noise), win);
+                    let measured = eigen(m).0.sqrt();
+                    eprintln!(
+                        "{name} {elevation}° d {distance} window ({wx}, {wy}): predicted {predicted:.3} measured {measured:.3} cycles/px; energy predicted {:.2e} measured {e:.2e}",
+                        energy / px.len() as f64
+                    );
+                    if measured.is_finite() && measured > 0.0 && predicted > 0.0 {
+                        xs.push(predicted.ln());
+                        ys.push(measured.ln());
+                        bw.push(predicted / measured);
+                        en.push(energy / px.len() as f64 / e);
+                    }
+                }
+            }
+        }
+        eprintln!(
+            "{name}: {} windows, predicted/measured median bandwidth {:.2}, energy {:.2}",
+            bw.len(),
+            median(bw.clone()),
+            median(en.clone())
+        );
+    }
+    let mut sorted: Vec<f64> = xs.iter().zip(&ys).map(|(x, y)| (x - y).exp()).collect();
+    sorted.sort_by(f64::total_cmp);
+    eprintln!(
+        "{} windows: log correlation {:.2}, rank {:.2}, predicted/measured median {:.2} (quartiles {:.2}–{:.2})",
+        xs.len(),
+        pearson(&xs, &ys),
+        spearman(&xs, &ys),
+        sorted[sorted.len() / 2],
+        sorted[sorted.len() / 4],
+        sorted[3 * sorted.len() / 4]
+    );
 }
