@@ -163,7 +163,7 @@ impl TruthDisplay {
                 "σ̂, one truth ray's luminance deviation predicted from the filtered model (Evaluator::predict_truth: visible colour, slopes, sun visibility, specular second moment); adaptive ground truth plans its rays with it [BSSBH13 Sec. 2.4]"
             }
             Self::PredictedBandwidth => {
-                "b, how fast the truth's image varies around each pixel, in cycles per pixel, predicted before any ray from the driver's waves through the colour map (its Hermite orders) and the shading's slope response, the cylinder's curvature through the lobe's width, and the pixel filter (Evaluator::predict_bandwidth, BSSBH13 Sec. 2.2). A lattice of step 2^floor(log2(1/2b)) samples it at Nyquist's rate [BSSBH13 Eq. 11]; 0.5 marks an edge (horizon, silhouette)"
+                "b, how fast the truth's image varies around each pixel, in cycles per pixel, predicted before any ray from the driver's waves through the colour map (its Hermite orders) and the shading's slope response, the cylinder's curvature through the lobe's width, and the pixel filter (Evaluator::predict_bandwidth, BSSBH13 Sec. 2.2). A lattice of step 2^floor(log2(1/2b)) samples it at Nyquist's rate [BSSBH13 Eq. 11]; 0.5 marks an edge (horizon, silhouette). Visibility is left out: where masking and shadow edges cut the relief the truth varies about twice as fast"
             }
             Self::Rays => {
                 "Rays each pixel has: uniform truth gives every pixel the same; adaptive truth gives them in proportion to σ̂ + ½·mean σ̂, pooled with each pixel's measured deviation"
