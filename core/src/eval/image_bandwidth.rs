@@ -50,7 +50,7 @@
 
 use crate::driver::field::DriverField;
 use crate::driver::footprint::Footprint;
-use crate::eval::query::FootprintQuery;
+use crate::eval::query::{FootprintQuery, FootprintStats};
 use crate::eval::{Evaluator, shading::specular_tint};
 use crate::material::colormap::LUMINANCE;
 use crate::math::gaussian::cholesky;
@@ -159,14 +159,15 @@ impl Evaluator {
     /// The response of the pixel's luminance to the driver (module docs): its mean, the energy
     /// of each order n = 1…[`CHAOS_ORDERS`] of `ℓ(f̄)` over the resolved driver `f̄ ~ N(m, v)`,
     /// and the gradient with respect to the slope, both averaged over the footprint's unresolved
-    /// values and slopes; `frame` the tangent frame, as [`Evaluator::filtered`] takes it.
+    /// values and slopes (`loc`, the footprint's statistics); `frame` the tangent frame, as
+    /// [`Evaluator::filtered`] takes it.
     fn radiance_response(
         &self,
         cfg: &FootprintQuery,
+        loc: &FootprintStats,
         frame: &DMat3,
         (m, v): (f64, f64),
     ) -> (f64, [f64; CHAOS_ORDERS], DVec2) {
-        let loc = self.footprint_stats(cfg);
         let su = loc.driver.std;
         // The field's mean slope (the resolved slope at x0 is one realisation of what the
         // spectrum describes): the macro surface's.
@@ -247,36 +248,36 @@ impl Evaluator {
         }
         let fp = cfg.footprint;
         let d = &self.surface.driver;
-        let here = d.filtered(cfg.x0, fp);
-        // The resolved driver's spectrum: per wave for the noise; for an image its second moment
-        // `R/(2π)²` from the resolved gradient covariance.
+        let loc = self.footprint_stats(cfg);
+        // The resolved driver's spectrum: per wave for the noise (amplitudes under the pixel's
+        // footprint); for an image its second moment `R/(2π)²` from the resolved gradient
+        // covariance, about the whole image's mean.
         let mut resolved = Spectrum::default();
-        match d {
-            DriverField::Noise(n) => {
-                for w in &n.waves {
-                    let a = w.amplitude * n.attenuation(w, fp);
-                    resolved.add(0.5 * a * a, w.k);
-                }
-            }
-            DriverField::Image(_) => {
-                let whole = d.filtered(cfg.x0, Footprint::isotropic(1e3 * d.coarsest_scale()));
-                let r = d.gradient_cov().to_mat() - here.gradient_cov.to_mat();
-                resolved.energy = (whole.std * whole.std - here.std * here.std).max(0.0);
-                resolved.moment = DMat2::from_cols(
-                    DVec2::new(r.x_axis.x.max(0.0), r.x_axis.y),
-                    DVec2::new(r.y_axis.x, r.y_axis.y.max(0.0)),
-                ) * (1.0 / (TAU * TAU));
-            }
+        let mut global_mean = 0.0;
+        let amplitudes: Vec<(DVec2, f64)> = match d {
+            DriverField::Noise(n) => n
+                .waves
+                .iter()
+                .map(|w| (w.k, w.amplitude * n.attenuation(w, fp)))
+                .collect(),
+            DriverField::Image(_) => Vec::new(),
+        };
+        for (k, a) in &amplitudes {
+            resolved.add(0.5 * a * a, *k);
+        }
+        if let DriverField::Image(_) = d {
+            let here = &loc.driver;
+            let whole = d.filtered(cfg.x0, Footprint::isotropic(1e3 * d.coarsest_scale()));
+            let r = d.gradient_cov().to_mat() - here.gradient_cov.to_mat();
+            resolved.energy = (whole.std * whole.std - here.std * here.std).max(0.0);
+            resolved.moment = DMat2::from_cols(
+                DVec2::new(r.x_axis.x.max(0.0), r.x_axis.y),
+                DVec2::new(r.y_axis.x, r.y_axis.y.max(0.0)),
+            ) * (1.0 / (TAU * TAU));
+            global_mean = whole.mean;
         }
         let v = resolved.energy;
-        let global_mean = match d {
-            DriverField::Noise(_) => 0.0,
-            DriverField::Image(_) => {
-                d.filtered(cfg.x0, Footprint::isotropic(1e3 * d.coarsest_scale()))
-                    .mean
-            }
-        };
-        let (mean, chaos, ls) = self.radiance_response(cfg, frame, (global_mean, v));
+        let (mean, chaos, ls) = self.radiance_response(cfg, &loc, frame, (global_mean, v));
         if v > 0.0 {
             // Order n's spectrum is the n-fold convolution of the driver's (normalised): its
             // second moment is n times the driver's.
@@ -290,26 +291,19 @@ impl Evaluator {
         }
         // The slope's first order: wave k tilts the surface by τ·k (τ = 2π σ_h g′).
         let tau = TAU * self.transfer_slope(global_mean);
-        match d {
-            DriverField::Noise(n) => {
-                for w in &n.waves {
-                    let a = w.amplitude * n.attenuation(w, fp);
-                    let t = tau * a * ls.dot(w.k);
-                    out.add(0.5 * t * t, w.k);
-                }
-            }
-            DriverField::Image(_) => {
-                let r = resolved.moment * (TAU * TAU);
-                let e = tau * tau * ls.dot(r * ls) / (TAU * TAU);
-                if e > 0.0 && v > 0.0 {
-                    out.energy += e;
-                    out.moment += resolved.moment * (e / v);
-                }
+        for (k, a) in &amplitudes {
+            let t = tau * a * ls.dot(*k);
+            out.add(0.5 * t * t, *k);
+        }
+        if amplitudes.is_empty() && v > 0.0 {
+            let e = tau * tau * ls.dot(resolved.moment * ls);
+            if e > 0.0 {
+                out.energy += e;
+                out.moment += resolved.moment * (e / v);
             }
         }
         if curvature != 0.0 && curvature.is_finite() {
-            let (diffuse, specular) = self.lobe_luminances(cfg, frame);
-            let loc = self.footprint_stats(cfg);
+            let (diffuse, specular) = self.lobe_luminances(cfg, &loc, frame);
             let b = &self.material.brdf;
             let width = (b.roughness * b.roughness + loc.stats.slope_cov.yy)
                 .sqrt()
@@ -331,8 +325,12 @@ impl Evaluator {
 
     /// The luminance of the footprint's diffuse (with the environment) and specular parts, at its
     /// mean slope.
-    fn lobe_luminances(&self, cfg: &FootprintQuery, frame: &DMat3) -> (f64, f64) {
-        let loc = self.footprint_stats(cfg);
+    fn lobe_luminances(
+        &self,
+        cfg: &FootprintQuery,
+        loc: &FootprintStats,
+        frame: &DMat3,
+    ) -> (f64, f64) {
         let n = normal_of(loc.stats.slope_mean);
         let aff = self.material.terms.affine(self.color_at(loc.driver.mean));
         let s = self.point_shading(n, cfg.wi, frame);
@@ -379,20 +377,11 @@ impl Evaluator {
                     ((i as u32 * step + step / 2).min(n.saturating_sub(1))) as f64 + 0.5
                 };
                 let px = DVec2::new(centre(p % bw, width), centre(p / bw, height));
-                let (cfg, frame, curvature) = match shape {
-                    Shape::Plane => {
-                        let (_, cov) = plane_camera.plane_footprint(px, width, height)?;
-                        let ray = plane_camera.ray(px, width, height);
-                        let fp = Footprint { cov };
-                        let (cfg, _) = self.pixel_query(ray.origin, ray.dir, wi, fp)?;
-                        (cfg, DMat3::IDENTITY, 0.0)
-                    }
-                    Shape::Cylinder { radius } => {
-                        let (o, d, wi, fp, frame) =
-                            self.cylinder_query(radius, camera, px, (width, height), wi)?;
-                        let (cfg, _) = self.pixel_query(o, d, wi, fp)?;
-                        (cfg, frame, 1.0 / radius)
-                    }
+                let (cfg, _, frame) =
+                    self.view_pixel_query(shape, &plane_camera, camera, px, (width, height), wi)?;
+                let curvature = match shape {
+                    Shape::Plane => 0.0,
+                    Shape::Cylinder { radius } => 1.0 / radius,
                 };
                 let b = self.pixel_bandwidth(&cfg, &frame, curvature);
                 Some(if b.is_finite() { b } else { NYQUIST })

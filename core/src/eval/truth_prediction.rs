@@ -3,7 +3,8 @@
 //! ([`Evaluator::predicted_ray_moments`]), both from the statistical model, before any ray is
 //! traced. [`crate::eval::sampling_plan::SamplingPlan`] turns them into ray counts.
 
-use crate::eval::Evaluator;
+use crate::driver::footprint::Footprint;
+use crate::eval::{Evaluator, FootprintQuery};
 use crate::material::colormap::LUMINANCE;
 use crate::scene::camera::Camera;
 use crate::scene::shape::Shape;
@@ -40,6 +41,37 @@ impl TruthPrediction {
 }
 
 impl Evaluator {
+    /// Where the analytic views evaluate pixel centre `px` of a `width × height` view of
+    /// `shape`: the footprint query, whether the sun reaches it, and the tangent frame (the
+    /// identity on the plane). `plane_camera` is `camera` lifted clear of the relief
+    /// ([`crate::scene::surface::Surface::clear_camera`]); the cylinder lifts its own. `None` for
+    /// the sky.
+    pub fn view_pixel_query(
+        &self,
+        shape: Shape,
+        plane_camera: &Camera,
+        camera: &Camera,
+        px: DVec2,
+        (width, height): (u32, u32),
+        wi: DVec3,
+    ) -> Option<(FootprintQuery, bool, DMat3)> {
+        match shape {
+            Shape::Plane => {
+                let (_, cov) = plane_camera.plane_footprint(px, width, height)?;
+                let ray = plane_camera.ray(px, width, height);
+                let (cfg, visible) =
+                    self.pixel_query(ray.origin, ray.dir, wi, Footprint { cov })?;
+                Some((cfg, visible, DMat3::IDENTITY))
+            }
+            Shape::Cylinder { radius } => {
+                let (o, d, wi, fp, frame) =
+                    self.cylinder_query(radius, camera, px, (width, height), wi)?;
+                let (cfg, visible) = self.pixel_query(o, d, wi, fp)?;
+                Some((cfg, visible, frame))
+            }
+        }
+    }
+
     /// The prediction for a `width × height` view of the plane by `camera` (lifted clear of the
     /// relief as every view is: [`crate::scene::surface::Surface::clear_camera`]) under the sun
     /// direction `wi`: each pixel's centre ray meets the level-of-detail surface where the
@@ -65,26 +97,8 @@ impl Evaluator {
             .into_par_iter()
             .map(|p| {
                 let px = DVec2::new((p % w) as f64 + 0.5, (p / w) as f64 + 0.5);
-                let query = match shape {
-                    Shape::Plane => plane_camera
-                        .plane_footprint(px, width, height)
-                        .and_then(|(_, cov)| {
-                            let ray = plane_camera.ray(px, width, height);
-                            self.pixel_query(
-                                ray.origin,
-                                ray.dir,
-                                wi,
-                                crate::driver::footprint::Footprint { cov },
-                            )
-                        })
-                        .map(|(cfg, visible)| (cfg, visible, DMat3::IDENTITY)),
-                    Shape::Cylinder { radius } => self
-                        .cylinder_query(radius, camera, px, (width, height), wi)
-                        .and_then(|(o, d, wi, fp, frame)| {
-                            self.pixel_query(o, d, wi, fp)
-                                .map(|(cfg, visible)| (cfg, visible, frame))
-                        }),
-                };
+                let query =
+                    self.view_pixel_query(shape, &plane_camera, camera, px, (width, height), wi);
                 let Some((cfg, visible, frame)) = query else {
                     return ([0.0; 3], 0.0);
                 };
