@@ -292,7 +292,7 @@ fn a_view_is_flat_far_away_and_sharp_at_the_horizon() {
 fn predicted_bandwidth_against_the_truths() {
     use crate::math::correlation::{pearson, spearman};
     let (w, h, win, rays) = (128u32, 96u32, 32usize, 64);
-    let (mut xs, mut ys) = (vec![], vec![]);
+    let (mut xs, mut ys, mut resolvable) = (vec![], vec![], vec![]);
     let median = |mut v: Vec<f64>| {
         v.sort_by(f64::total_cmp);
         if v.is_empty() {
@@ -349,6 +349,10 @@ fn predicted_bandwidth_against_the_truths() {
                         ys.push(measured.ln());
                         bw.push(predicted / measured);
                         en.push(energy / px.len() as f64 / e);
+                        // A window holds two periods or more of what it is to measure.
+                        if predicted.max(measured) >= 2.0 / win as f64 {
+                            resolvable.push(predicted / measured);
+                        }
                     }
                 }
             }
@@ -370,5 +374,10 @@ fn predicted_bandwidth_against_the_truths() {
         sorted[sorted.len() / 2],
         sorted[sorted.len() / 4],
         sorted[3 * sorted.len() / 4]
+    );
+    eprintln!(
+        "{} windows holding two periods: predicted/measured median {:.2}",
+        resolvable.len(),
+        median(resolvable.clone())
     );
 }
