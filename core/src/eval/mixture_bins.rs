@@ -24,20 +24,22 @@
 //! **Conditioned on the driver's slope (CPU prototype, #17).** With
 //! [`Evaluator::transfer_masking`] set (only measurements set it), each bin is also summed over
 //! its [`BIN_SAMPLES`] sub-values, each with its own g′ and its own visibility (a riser and a tread
-//! in one bin are two slope scales, not their root mean square), and node by node over the
-//! driver's slopes ([`CONDITIONED_SLOPE_POINTS`]). Each node is weighted by its projected area, its
-//! conditioned G1 along ωo and its joint masking–shadowing
-//! ([`crate::eval::transfer_masking_table::TransferRays::node_visibility`]). Each sub-value's
+//! in one bin are two slope scales, not their root mean square). Its conditioned G1 along ωo and
+//! joint masking–shadowing over the driver's slopes
+//! ([`crate::eval::transfer_masking_table::TransferRays::node_visibility`] on
+//! [`CONDITIONED_SLOPE_POINTS`]² nodes) enter as moments: each reweights the slopes' Gaussian into
+//! another ([`VisibilityMoments::tilted`]), which the bin shades as it shades any Gaussian of
+//! slopes (within 0.9% of summing shading and visibility node by node on #17's grid). Each sub-value's
 //! specular lobe is widened by its own slopes and takes the joint term over the driver slopes of
 //! its half-vector posterior ([`Evaluator::lobe_visible_mass`]). The two are blended by the
 //! footprint's far weight (docs/design.md, "Transfer curves: masking that knows the driver's
-//! slope"). On #17's grid the sub-values took terraces' worst excess from 3.63% to 1.93% (0–60°)
-//! and from 4.34% to 1.94% (75–85°); Smith's bins have 5.06% and 14.46% there.
+//! slope"). On #17's grid the sub-values took terraces' worst excess from 3.63% to 2.05% (0–60°)
+//! and from 4.34% to 1.75% (75–85°); Smith's bins have 5.06% and 14.46% there.
 
 use crate::driver::conditional_slopes::ImageSlopes;
 use crate::eval::query::FootprintStats;
 use crate::eval::shading::{SlopeShading, specular_tint};
-use crate::eval::transfer_masking_table::TransferRays;
+use crate::eval::transfer_masking_table::{TransferRays, VisibilityMoments};
 use crate::eval::{Evaluator, FootprintQuery};
 use crate::material::transfer::TransferFunction;
 use crate::math::gaussian::cholesky;
@@ -47,7 +49,7 @@ use crate::microfacet::height_mixture::{
     BIN_SAMPLES, bin_exponent, bin_masking, bin_slope_points, mixture_edges,
 };
 use crate::microfacet::masking_shadowing::G2;
-use crate::microfacet::slopes::normal_of;
+use crate::microfacet::slopes::SlopeCov;
 use crate::microfacet::visible_slopes::slope_rule;
 use glam::{DMat3, DVec2, DVec3};
 
@@ -223,23 +225,44 @@ impl Evaluator {
                 let xq = rays.value_at(lo + (hi - lo) * (q as f64 + 0.5) * ks);
                 let gd = m.heights.transfer.derivative(xq);
                 let mean_q = d.mean_gradient * (sigma_h * gd);
-                let (mut so_q, mut s2o_q) = (0.0, 0.0);
-                for (z, wz) in slope_rule(conditioned_points) {
-                    let sl = mean_q + rays.gradient_at(*z) * (sigma_h * gd);
-                    let u = (cfg.wo.z - sl.x * cfg.wo.x - sl.y * cfg.wo.y).max(0.0);
-                    if u == 0.0 {
-                        continue;
-                    }
-                    let shade = self.point_shading(normal_of(sl), cfg.wi, frame);
-                    let (go, g2) = rays.node_visibility(xq, *z);
-                    so_q += wz * u;
-                    s2o_q += wz * u * g2;
-                    s1.add(&shade, ks * wz * u * go);
-                    s1o += ks * wz * u * go;
-                    s2.add(&shade, ks * wz * u * g2);
+                // The conditioned visibility as a reweighting of the driver slopes' Gaussian (its
+                // moments), shaded as the bins shade any Gaussian of slopes.
+                let lz = rays.gradient_factor() * (sigma_h * gd);
+                let [vo, v2] = rays.visibility_moments(xq, conditioned_points);
+                let shade_under = |v: &VisibilityMoments| {
+                    let (m0, mu, c) = v.tilted()?;
+                    let cov = SlopeCov::from_mat(lz * c * lz.transpose());
+                    let (sh, so) = self.visible_shading_sums(
+                        mean_q + lz * mu,
+                        &cov,
+                        cfg.wo,
+                        cfg.wi,
+                        frame,
+                        conditioned_points,
+                    );
+                    Some((m0, sh, so))
+                };
+                if let Some((m0, sh, so)) = shade_under(&vo) {
+                    s1.add(&sh, ks * m0);
+                    s1o += ks * m0 * so;
+                }
+                let mut s2o_q = 0.0;
+                if let Some((m0, sh, so)) = shade_under(&v2) {
+                    s2.add(&sh, ks * m0);
+                    s2o_q = m0 * so;
                 }
                 if sun_lit {
                     let cov_q = d.gradient_cov.scaled(sigma_h * gd);
+                    let so_q = self
+                        .visible_shading_sums(
+                            mean_q,
+                            &cov_q,
+                            cfg.wo,
+                            cfg.wi,
+                            frame,
+                            conditioned_points,
+                        )
+                        .1;
                     let lobe = self.specular_lobes(mean_q, &cov_q, cfg.wo, cfg.wi);
                     let mass = self
                         .lobe_visible_mass(

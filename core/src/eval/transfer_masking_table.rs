@@ -325,6 +325,38 @@ pub struct TransferRays {
     far: f64,
 }
 
+/// The moments of a visibility weight g over the footprint's whitened driver slopes
+/// `z ~ N(0, I)`: `E[g]`, `E[z g]`, `E[z zᵀ g]` ([`TransferRays::visibility_moments`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VisibilityMoments {
+    /// `E[g]`.
+    pub mass: f64,
+    /// `E[z g]`.
+    pub first: DVec2,
+    /// `E[z zᵀ g]`.
+    pub second: glam::DMat2,
+}
+
+impl VisibilityMoments {
+    /// The weight as a reweighting of the slopes' Gaussian: `(E[g], μ, C)` with the tilted
+    /// Gaussian `N(μ, C)`, `μ = E[z g]/E[g]`, `C = E[z zᵀ g]/E[g] − μμᵀ` (clamped to be positive
+    /// semi-definite). `None` where nothing is visible.
+    pub fn tilted(&self) -> Option<(f64, DVec2, glam::DMat2)> {
+        if !(self.mass > 1e-12) {
+            return None;
+        }
+        let mu = self.first / self.mass;
+        let c = self.second * (1.0 / self.mass) - glam::DMat2::from_cols(mu * mu.x, mu * mu.y);
+        let (xx, yy) = (c.x_axis.x.max(0.0), c.y_axis.y.max(0.0));
+        let xy = (0.5 * (c.x_axis.y + c.y_axis.x)).clamp(-(xx * yy).sqrt(), (xx * yy).sqrt());
+        Some((
+            self.mass,
+            mu,
+            glam::DMat2::from_cols(DVec2::new(xx, xy), DVec2::new(xy, yy)),
+        ))
+    }
+}
+
 impl TransferRays {
     /// For the footprint's driver `d`, `wo` and `wi` in the frame of its mean normal, the light
     /// up or not, σ_h and the material's correlation.
@@ -388,6 +420,35 @@ impl TransferRays {
             lo * hi.powf(self.k)
         });
         (go, g2)
+    }
+
+    /// The moments of G1 along ωo and of the joint G2 of a start at driver value `x` over the
+    /// footprint's driver slopes, on the polar rule of `points` ([`slope_rule`]): the visibility
+    /// as a reweighting of the slopes' Gaussian, which the bins then shade as any Gaussian
+    /// (docs/design.md, "The visibility as a Gaussian reweighting").
+    pub fn visibility_moments(&self, x: f64, points: usize) -> [VisibilityMoments; 2] {
+        let zero = VisibilityMoments {
+            mass: 0.0,
+            first: DVec2::ZERO,
+            second: glam::DMat2::ZERO,
+        };
+        let mut out = [zero; 2];
+        for (z, w) in crate::microfacet::visible_slopes::slope_rule(points) {
+            let (go, g2) = self.node_visibility(x, *z);
+            for (m, g) in out.iter_mut().zip([go, g2]) {
+                let wg = w * g;
+                m.mass += wg;
+                m.first += *z * wg;
+                m.second += glam::DMat2::from_cols(*z * z.x, *z * z.y) * wg;
+            }
+        }
+        out
+    }
+
+    /// The footprint's unresolved driver-gradient Cholesky factor as a matrix (`z ↦ L z`,
+    /// [`TransferRays::gradient_at`]).
+    pub fn gradient_factor(&self) -> glam::DMat2 {
+        glam::DMat2::from_cols(self.gradient_at(DVec2::X), self.gradient_at(DVec2::Y))
     }
 
     /// The driver gradient `L z` of the standard node `z` (L the Cholesky factor of the
@@ -530,6 +591,30 @@ mod tests {
         assert_eq!(far_weight(0.5, 1.0), 0.25);
         assert_eq!(far_weight(f64::NAN, 1.0), 0.0);
         assert_eq!(far_weight(3.0, 0.0), 0.0);
+    }
+
+    /// A reweighting's tilted Gaussian: `E[g] = 2`, `E[z g] = (2, 0)`, `E[z zᵀ g] = diag(4, 2)`
+    /// is twice N((1, 0), I); an impossible second moment is clamped to a degenerate Gaussian;
+    /// nothing visible is `None`.
+    #[test]
+    fn visibility_moments_tilt_the_gaussian() {
+        let m = VisibilityMoments {
+            mass: 2.0,
+            first: DVec2::new(2.0, 0.0),
+            second: glam::DMat2::from_cols(DVec2::new(4.0, 0.0), DVec2::new(0.0, 2.0)),
+        };
+        let (m0, mu, c) = m.tilted().expect("visible");
+        assert_eq!(m0, 2.0);
+        assert!((mu - DVec2::new(1.0, 0.0)).length() < 1e-12);
+        assert!((c - glam::DMat2::IDENTITY).abs_diff_eq(glam::DMat2::ZERO, 1e-12));
+        let bad = VisibilityMoments {
+            second: glam::DMat2::ZERO,
+            ..m
+        };
+        let (_, _, c) = bad.tilted().expect("visible");
+        assert!(c.x_axis.x >= 0.0 && c.y_axis.y >= 0.0 && c.determinant() >= -1e-12);
+        let none = VisibilityMoments { mass: 0.0, ..m };
+        assert!(none.tilted().is_none());
     }
 
     /// The filtered view with the conditioned bins: at the normal, where nothing is masked or
