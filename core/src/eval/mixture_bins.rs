@@ -26,8 +26,8 @@
 //! its [`BIN_SAMPLES`] sub-values, each with its own g′ and its own visibility (a riser and a tread
 //! in one bin are two slope scales, not their root mean square). Its conditioned G1 along ωo and
 //! joint masking–shadowing over the driver's slopes
-//! ([`crate::eval::transfer_masking_table::TransferRays::node_visibility`] on
-//! [`CONDITIONED_SLOPE_POINTS`]² nodes) enter as moments: each reweights the slopes' Gaussian into
+//! ([`crate::eval::transfer_masking_table::TransferRays::visibility_moments`], on a rule aligned
+//! with the eye's projection) enter as moments: each reweights the slopes' Gaussian into
 //! another ([`VisibilityMoments::tilted`]), which the bin shades as it shades any Gaussian of
 //! slopes (within 0.9% of summing shading and visibility node by node on #17's grid). Each sub-value's
 //! specular lobe is widened by its own slopes and takes the joint term over the driver slopes of
@@ -228,7 +228,7 @@ impl Evaluator {
                 // The conditioned visibility as a reweighting of the driver slopes' Gaussian (its
                 // moments), shaded as the bins shade any Gaussian of slopes.
                 let lz = rays.gradient_factor() * (sigma_h * gd);
-                let [vo, v2] = rays.visibility_moments(xq, conditioned_points);
+                let [vo, v2] = rays.visibility_moments(xq);
                 let shade_under = |v: &VisibilityMoments| {
                     let (m0, mu, c) = v.tilted()?;
                     let cov = SlopeCov::from_mat(lz * c * lz.transpose());

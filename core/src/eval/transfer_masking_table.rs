@@ -325,6 +325,11 @@ pub struct TransferRays {
     far: f64,
 }
 
+/// Gauss–Hermite nodes (along the eye's projection, across it) of
+/// [`TransferRays::visibility_moments`]: 6 × 3 is as good as the 64-node polar rule on #17's
+/// grid (terraces 2.01% / 1.98%, sponge 0.23% / 12.67%, moss 0 / 0), 8 × 4 and 12 × 6 no better.
+pub const MOMENT_NODES: (usize, usize) = (6, 3);
+
 /// The moments of a visibility weight g over the footprint's whitened driver slopes
 /// `z ~ N(0, I)`: `E[g]`, `E[z g]`, `E[z zᵀ g]` ([`TransferRays::visibility_moments`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -423,23 +428,43 @@ impl TransferRays {
     }
 
     /// The moments of G1 along ωo and of the joint G2 of a start at driver value `x` over the
-    /// footprint's driver slopes, on the polar rule of `points` ([`slope_rule`]): the visibility
-    /// as a reweighting of the slopes' Gaussian, which the bins then shade as any Gaussian
-    /// (docs/design.md, "The visibility as a Gaussian reweighting").
-    pub fn visibility_moments(&self, x: f64, points: usize) -> [VisibilityMoments; 2] {
+    /// footprint's driver slopes: the visibility as a reweighting of the slopes' Gaussian, which
+    /// the bins then shade as any Gaussian (docs/design.md, "The visibility as a Gaussian
+    /// reweighting"). On a Gauss–Hermite product rule aligned with the eye's projection
+    /// ([`MOMENT_NODES`]): G1 along ωo depends on the slope only through it, so it is read at the
+    /// along-nodes alone (6 reads of the table instead of 64 on the polar rule, the light's 18;
+    /// #17's grid moves by at most 1% against the 64-node polar rule).
+    pub fn visibility_moments(&self, x: f64) -> [VisibilityMoments; 2] {
         let zero = VisibilityMoments {
             mass: 0.0,
             first: DVec2::ZERO,
             second: glam::DMat2::ZERO,
         };
         let mut out = [zero; 2];
-        for (z, w) in crate::microfacet::visible_slopes::slope_rule(points) {
-            let (go, g2) = self.node_visibility(x, *z);
-            for (m, g) in out.iter_mut().zip([go, g2]) {
-                let wg = w * g;
-                m.mass += wg;
-                m.first += *z * wg;
-                m.second += glam::DMat2::from_cols(*z * z.x, *z * z.y) * wg;
+        let p = self.o.projection;
+        let (e1, e2) = if p.length() > 1e-12 {
+            let e = p.normalize();
+            (e, e.perp())
+        } else {
+            (DVec2::X, DVec2::Y)
+        };
+        let (az, aw) = gauss_hermite_normal(MOMENT_NODES.0);
+        let (bz, bw) = gauss_hermite_normal(MOMENT_NODES.1);
+        for (a, wa) in az.iter().zip(&aw) {
+            let go = entry_at(&self.o.entry, x, p.length() * a).exp();
+            for (b, wb) in bz.iter().zip(&bw) {
+                let z = e1 * *a + e2 * *b;
+                let g2 = self.i.as_ref().map_or(0.0, |i| {
+                    let gi = entry_at(&i.entry, x, i.projection.dot(z)).exp();
+                    let (lo, hi) = if go <= gi { (go, gi) } else { (gi, go) };
+                    lo * hi.powf(self.k)
+                });
+                for (m, g) in out.iter_mut().zip([go, g2]) {
+                    let wg = wa * wb * g;
+                    m.mass += wg;
+                    m.first += z * wg;
+                    m.second += glam::DMat2::from_cols(z * z.x, z * z.y) * wg;
+                }
             }
         }
         out
