@@ -259,8 +259,13 @@ fn a_view_is_flat_far_away_and_sharp_at_the_horizon() {
             .iter()
             .any(|v| *v < 0.05)
     );
-    let levels = b.levels(4);
-    assert!(levels.iter().all(|l| *l <= 4));
+    // BSSBH13's Eq. 11 levels: a step of 2^level samples at twice the bandwidth or more.
+    let eq11 = crate::eval::image_bandwidth::BandwidthPrediction {
+        width: 5,
+        height: 1,
+        cycles: vec![0.5, 0.25, 0.1, 0.01, 0.0],
+    };
+    assert_eq!(eq11.levels(4), vec![0, 1, 2, 4, 4]);
     // Blocks of 3: each takes its centre pixel's value.
     let coarse = ev.predict_bandwidth(Shape::Plane, &camera, (w, h), wi, 3);
     assert_eq!((coarse.width, coarse.height), (24, 18));
