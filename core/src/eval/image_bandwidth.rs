@@ -53,7 +53,7 @@ use crate::driver::footprint::Footprint;
 use crate::eval::query::{FootprintQuery, FootprintStats};
 use crate::eval::{Evaluator, shading::specular_tint};
 use crate::material::colormap::LUMINANCE;
-use crate::math::gaussian::cholesky;
+use crate::math::gaussian::{cholesky, eigenvalues};
 use crate::math::quadrature::gauss_hermite_normal;
 use crate::microfacet::slopes::normal_of;
 use crate::microfacet::visible_slopes::slope_rule;
@@ -115,9 +115,7 @@ impl Spectrum {
             return 0.0;
         }
         // λ_max of the 2×2 product (eigenvalues real and ≥ 0: similar to Jᵀ·moment·J).
-        let a = self.moment * m;
-        let (tr, det) = (a.x_axis.x + a.y_axis.y, a.determinant());
-        let lambda = 0.5 * (tr + (tr * tr - 4.0 * det).max(0.0).sqrt());
+        let lambda = eigenvalues(self.moment * m).0;
         let b = (lambda.max(0.0) / total).sqrt();
         if b.is_finite() {
             b.min(NYQUIST)

@@ -8,6 +8,7 @@ use crate::eval::image_bandwidth::{NYQUIST, Spectrum};
 use crate::eval::query::FootprintQuery;
 use crate::eval::test_materials::preset;
 use crate::material::colormap::LUMINANCE;
+use crate::math::gaussian::eigenvalues;
 use crate::math::quadrature::gauss_hermite_normal;
 use crate::microfacet::slopes::normal_of;
 use crate::scene::camera::{Camera, PIXEL_SIGMA};
@@ -74,13 +75,6 @@ fn measured_spectrum(img: &[f64], noise: Option<&[f64]>, n: usize) -> (DMat2, f6
     }
     let energy = e / (n * n) as f64 / window_power;
     (m * (1.0 / e), energy)
-}
-
-/// Eigenvalues of a symmetric 2×2 matrix, larger first.
-fn eigen(m: DMat2) -> (f64, f64) {
-    let (tr, det) = (m.x_axis.x + m.y_axis.y, m.determinant());
-    let d = (tr * tr - 4.0 * det).max(0.0).sqrt();
-    (0.5 * (tr + d), 0.5 * (tr - d))
 }
 
 /// Against brute force: the explicit surface's radiance averaged over each pixel's Gaussian
@@ -164,8 +158,8 @@ fn the_predicted_spectrum_is_the_images() {
         let var = img.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / img.len() as f64;
         let e = predicted.energy / 256.0;
         let got = measured_moment(&img, n);
-        let (w1, w2) = eigen(want);
-        let (g1, g2) = eigen(got);
+        let (w1, w2) = eigenvalues(want);
+        let (g1, g2) = eigenvalues(got);
         let ratios = [w1.sqrt() / g1.sqrt(), w2.sqrt() / g2.sqrt(), e / var];
         eprintln!(
             "{name}: predicted/measured bandwidth {:.3} (fast axis) {:.3} (slow), energy {:.3}",
@@ -344,7 +338,7 @@ fn predicted_bandwidth_against_the_truths() {
                     let img: Vec<f64> = px.iter().map(|p| p.2).collect();
                     let noise: Vec<f64> = px.iter().map(|p| p.3).collect();
                     let (m, e) = measured_spectrum(&img, Some(&noise), win);
-                    let measured = eigen(m).0.sqrt();
+                    let measured = eigenvalues(m).0.sqrt();
                     eprintln!(
                         "{name} {elevation}° d {distance} window ({wx}, {wy}): predicted {predicted:.3} measured {measured:.3} cycles/px; energy predicted {:.2e} measured {e:.2e}",
                         energy / px.len() as f64

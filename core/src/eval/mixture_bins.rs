@@ -184,11 +184,14 @@ impl Evaluator {
             let w2 = bin_masking(lo, hi, ms.total, above);
             above_o += bin_exponent(lo, hi, ms.lambda_o);
             above += bin_exponent(lo, hi, ms.total);
-            let (s, s_o): (SlopeShading, f64) =
-                self.visible_shading_sums(mean, &cov, cfg.wo, cfg.wi, frame, points);
+            // Smith's bin: its visible-slope sums, projected area and lobe (computed only where
+            // they are used: the conditioned path of a far footprint has no Smith share).
+            let smith = || {
+                let (s, s_o) = self.visible_shading_sums(mean, &cov, cfg.wo, cfg.wi, frame, points);
+                let spec = sun_lit.then(|| self.specular_lobes(mean, &cov, cfg.wo, cfg.wi));
+                (s, s_o, spec.map_or([0.0; 3], |l| l.map(|l| l * s_o)))
+            };
             let c = m.terms.affine(bin.color);
-            let lobe = sun_lit.then(|| self.specular_lobes(mean, &cov, cfg.wo, cfg.wi));
-            let lobe_times = |mass: f64| lobe.map_or([0.0; 3], |l| l.map(|l| l * mass));
             // One part of the bin, weighted by `share`: masses w1 (seen) and w2 (seen and lit),
             // the shading sums weighted by the masking (environment) and by the joint term
             // (sun), and the lobe's visible mass.
@@ -209,12 +212,14 @@ impl Evaluator {
                 }
             };
             let Some(rays) = &conditioned else {
-                add(1.0, (w1, w2), &s, s_o, &s, lobe_times(s_o));
+                let (s, s_o, spec) = smith();
+                add(1.0, (w1, w2), &s, s_o, &s, spec);
                 continue;
             };
             // Smith's bin blended with the conditioned one by the footprint's far weight.
             if rays.far() < 1.0 {
-                add(1.0 - rays.far(), (w1, w2), &s, s_o, &s, lobe_times(s_o));
+                let (s, s_o, spec) = smith();
+                add(1.0 - rays.far(), (w1, w2), &s, s_o, &s, spec);
             }
             let (mut s1, mut s1o, mut s2) = (SlopeShading::default(), 0.0, SlopeShading::default());
             // Each of the bin's sub-values with its own g′ (a riser and a tread in one bin are
