@@ -5,6 +5,8 @@
 pub mod bessel;
 pub mod correlation;
 pub mod gaussian;
+pub mod gaussian_weight;
+pub mod log_linear_moments;
 pub mod piecewise;
 pub mod quadrature;
 pub mod random;
