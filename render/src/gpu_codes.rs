@@ -9,6 +9,7 @@ use lodestone_core::driver::conditional_slopes;
 use lodestone_core::driver::histogram::G_END;
 use lodestone_core::eval::lod_surface::LOD_SETTLE;
 use lodestone_core::eval::slope_masking_table;
+use lodestone_core::math::{gaussian_weight, log_linear_moments};
 use lodestone_core::microfacet::effective_height::{
     FIT_ALPHA_MU, FIT_ALPHA_SIGMA, FIT_BETA_MU, FIT_BETA_SIGMA,
 };
@@ -175,6 +176,10 @@ pub fn wgsl_prelude() -> &'static str {
             ("TABLE_AZIMUTHS", slope_masking_table::TABLE_AZIMUTHS as u32),
             ("TABLE_LEVELS", slope_masking_table::TABLE_LEVELS as u32),
             ("TABLE_NUS", slope_masking_table::TABLE_NUS as u32),
+            (
+                "TRANSFER_SLOPE_NODES",
+                lodestone_core::eval::transfer_masking_table::SLOPE_NODES as u32,
+            ),
             ("DATA_ROW", crate::renderer::DATA_ROW),
         ];
         for (name, v) in sets.into_iter().flatten().chain(counts) {
@@ -196,6 +201,18 @@ pub fn wgsl_prelude() -> &'static str {
             ("TABLE_NU_MIN", slope_masking_table::NU_MIN),
             ("TABLE_NU_RATIO", slope_masking_table::NU_RATIO),
             ("HEIGHT_NODE_DEPTH", -slope_masking::height_node(0)),
+            (
+                "LOG_LINEAR_MIN_DEVIATION",
+                log_linear_moments::MIN_DEVIATION,
+            ),
+            (
+                "LOG_LINEAR_MAX_DEVIATION",
+                log_linear_moments::MAX_DEVIATION,
+            ),
+            (
+                "GAUSSIAN_WEIGHT_MIN_VARIANCE",
+                gaussian_weight::MIN_VARIANCE,
+            ),
         ];
         for (name, v) in floats {
             let _ = writeln!(s, "const {name}: f32 = {:?};", v as f32);

@@ -9,13 +9,15 @@
 //! converging. Here:
 //! - **Mass.** On a cell `[a, b]` with slope β, completing the square,
 //!   `∫ exp(ℓ_a + β(t − a)) N(t; 0, s²) dt = exp(ℓ_a − βa + ½β²s²)·[Φ(u_b) − Φ(u_a)]`,
-//!   `u = (t − βs²)/s`. The bracket is taken from the tail both ends share, in logarithms
-//!   ([`log_norm_cdf`]), so a steep cell far in its tail neither overflows nor cancels.
+//!   `u = (t − βs²)/s`. The bracket is taken from the tail both ends share, scaled by the
+//!   integrand's largest value ([`erfcx`]), so a steep cell far in its tail neither overflows nor
+//!   cancels.
 //! - **First and second moments** by Stein's identity `E[t h(t)] = s² E[h′(t)]` (g is continuous):
 //!   `E[t g] = s² Σ β_j I_j` and `E[t² g] = s² E[g] + s⁴ (Σ β_j² I_j + Σ_k Δβ_k g(t_k) N(t_k; 0, s²))`,
 //!   `I_j` the cells' masses and `Δβ_k` the change of slope at knot k (β = 0 beyond the ends).
 
-use crate::math::special::{log_norm_cdf, norm_cdf, norm_pdf};
+use crate::math::special::{erfcx, norm_cdf, norm_pdf};
+use std::f64::consts::FRAC_1_SQRT_2;
 
 /// Below this deviation the Gaussian is a point: `(g(0), 0, 0)`.
 pub const MIN_DEVIATION: f64 = 1e-9;
@@ -79,24 +81,34 @@ pub fn log_linear_moments(knots: &[f64], values: &[f64], s: f64) -> (f64, f64, f
     (m0, s2 * sb, s2 * m0 + s2 * s2 * (sbb + nodes))
 }
 
-/// `∫_a^b exp(l + β(t − a)) N(t; 0, s²) dt` (module docs), `a < b`, `s > 0`.
+/// `∫_a^b exp(l + β(t − a)) N(t; 0, s²) dt` (module docs), `a < b`, `s > 0`. With
+/// `u = (t − βs²)/s`, the cell is below the tilted Gaussian's mean (`u_b ≤ 0`), above it
+/// (`u_a ≥ 0`) or around it; each case factors out the integrand's largest value, `ℓ − ½(t/s)²`
+/// at b, a or the mean, and the rest is a ratio of scaled complementary error functions ([`erfcx`])
+/// or a difference of Φ near the middle. No term exceeds the integrand's logarithm, so nothing
+/// cancels in f32 either.
 fn cell_mass(a: f64, b: f64, l: f64, beta: f64, s: f64) -> f64 {
     let shift = beta * s;
     let (ua, ub) = (a / s - shift, b / s - shift);
-    // ln of exp(l − βa + ½β²s²), written so that it stays moderate next to the Φ's logarithm.
-    let scale = l - beta * a + 0.5 * shift * shift;
-    let log_bracket = if ub <= 0.0 {
-        // Both in the lower tail: Φ(u_b)·(1 − Φ(u_a)/Φ(u_b)).
-        let (la, lb) = (log_norm_cdf(ua), log_norm_cdf(ub));
-        lb + (-(la - lb).exp()).ln_1p()
+    if ub <= 0.0 {
+        let lb = l + beta * (b - a) - 0.5 * (b / s) * (b / s);
+        let ratio = scaled_cdf(ua) / scaled_cdf(ub) * (-0.5 * (ua - ub) * (ua + ub)).exp();
+        lb.exp() * scaled_cdf(ub) * (1.0 - ratio).max(0.0)
     } else if ua >= 0.0 {
-        // Both in the upper tail: Φ(−u_a)·(1 − Φ(−u_b)/Φ(−u_a)).
-        let (la, lb) = (log_norm_cdf(-ua), log_norm_cdf(-ub));
-        la + (-(lb - la).exp()).ln_1p()
+        let la = l - 0.5 * (a / s) * (a / s);
+        let ratio = scaled_cdf(-ub) / scaled_cdf(-ua) * (-0.5 * (ub - ua) * (ub + ua)).exp();
+        la.exp() * scaled_cdf(-ua) * (1.0 - ratio).max(0.0)
     } else {
-        (norm_cdf(ub) - norm_cdf(ua)).max(0.0).ln()
-    };
-    (scale + log_bracket).exp()
+        let t = beta * s * s;
+        let peak = l + beta * (t - a) - 0.5 * (t / s) * (t / s);
+        peak.exp() * (norm_cdf(ub) - norm_cdf(ua)).max(0.0)
+    }
+}
+
+/// `Φ(u)·e^{u²/2} = ½erfcx(−u/√2)`: the normal CDF scaled by its own tail's decay (finite and
+/// accurate far below 0, where Φ underflows).
+fn scaled_cdf(u: f64) -> f64 {
+    0.5 * erfcx(-u * FRAC_1_SQRT_2)
 }
 
 #[cfg(test)]

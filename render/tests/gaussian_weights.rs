@@ -1,0 +1,245 @@
+//! The WGSL mirrors of #17's conditioned-visibility math (`math/log_linear_moments.wgsl`,
+//! `math/gaussian_weight.wgsl`) against lodestone-core's f64 on the GPU adapter: the exact Gaussian
+//! moments of real columns of the terraces table and of a column that falls by 30 in one cell,
+//! and the Gaussian weights' products, powers, expectations and tilts.
+
+use glam::{DMat2, DVec2};
+use lodestone_core::eval::transfer_masking_table::{
+    SLOPE_NODES, TransferMaskingTable, entry_at, slope_node,
+};
+use lodestone_core::material::Material;
+use lodestone_core::material::features::FeatureSet;
+use lodestone_core::math::gaussian_weight::GaussianWeight;
+use lodestone_core::math::log_linear_moments::log_linear_moments;
+use lodestone_render::{compute::eval_unary, gpu_codes, shaders};
+
+/// The two mirrored files with what they need (the constants prelude, the special functions),
+/// specialized for every feature, and `extra` (the test's cases and entry function).
+fn library(extra: &str) -> String {
+    let files = [
+        include_str!("../src/shaders/math/log_linear_moments.wgsl"),
+        include_str!("../src/shaders/math/gaussian_weight.wgsl"),
+    ];
+    let src = [
+        gpu_codes::wgsl_prelude(),
+        shaders::SPECIAL,
+        files[0],
+        files[1],
+        extra,
+    ]
+    .join("\n");
+    lodestone_render::specialize::specialize(&src, FeatureSet::all()).expect("specialized")
+}
+
+fn f32s(v: impl IntoIterator<Item = f64>) -> String {
+    v.into_iter()
+        .map(|x| format!("{:?}", x as f32))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Columns of the terraces table (eye at 60°, 75° and 85°, every fourth value node) and a
+/// synthetic back face, each under deviations from a tenth of a cell to 3 (a projection of the
+/// footprint's whitened slopes is at most about 1) and a point: the GPU's (E[g], E[t g], E[t² g])
+/// against core's, relative to E[g]·(1, s, s²). Measured worst 1.8e-5; at s = 25, E[t² g]
+/// cancels to 1.6e-3 in f32.
+#[test]
+fn wgsl_log_linear_moments_match_core_on_the_adapter() {
+    let Some(ctx) = lodestone_tests::gpu("the GPU mirror test") else {
+        return;
+    };
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../presets/terraces.ron"
+    ))
+    .expect("terraces preset");
+    let m = Material::from_ron(&text).expect("terraces");
+    let table = TransferMaskingTable::shared(&m.noise().expect("noise"), &m.heights.transfer)
+        .expect("a table");
+    let knots: Vec<f64> = (0..SLOPE_NODES).map(slope_node).collect();
+    let mut columns: Vec<Vec<f64>> = vec![];
+    for nu in [0.15, 0.6, 1.7] {
+        let entry = table.lookup(DVec2::new(0.8, 0.6), nu);
+        for x in [-3.0, -1.5, -0.4, 0.3, 1.2, 2.5] {
+            columns.push(knots.iter().map(|t| entry_at(&entry, x, *t)).collect());
+        }
+    }
+    columns.push(
+        knots
+            .iter()
+            .map(|t| if *t < 1.0 { -0.1 * (t + 4.0) } else { -30.0 })
+            .collect(),
+    );
+    let deviations = [0.05, 0.3, 0.8, 1.0, 1.4, 3.0, 0.0];
+    let mut cases = vec![];
+    for c in &columns {
+        // Core on the f32 values the GPU reads.
+        let c32: Vec<f64> = c.iter().map(|v| f64::from(*v as f32)).collect();
+        for s in deviations {
+            cases.push((c32.clone(), s));
+        }
+    }
+    let n = cases.len();
+    let extra = format!(
+        "var<private> COLUMNS: array<array<f32, {SLOPE_NODES}>, {n}> = array({});\n\
+         var<private> DEVIATIONS: array<f32, {n}> = array({});\n\
+         fn run(x: f32) -> f32 {{\n\
+             let i = u32(x) / 3u;\n\
+             let m = log_linear_moments(COLUMNS[i], {:?}, {:?}, DEVIATIONS[i]);\n\
+             return m[u32(x) % 3u];\n\
+         }}\n",
+        cases
+            .iter()
+            .map(|(c, _)| format!("array<f32, {SLOPE_NODES}>({})", f32s(c.iter().copied())))
+            .collect::<Vec<_>>()
+            .join(",\n"),
+        f32s(cases.iter().map(|c| c.1)),
+        slope_node(0) as f32,
+        (slope_node(1) - slope_node(0)) as f32,
+    );
+    let xs: Vec<f32> = (0..3 * n).map(|i| i as f32).collect();
+    let gpu = eval_unary(&ctx, &library(&extra), "run", &xs);
+    let mut worst = 0.0f64;
+    for (i, (c, s)) in cases.iter().enumerate() {
+        let want = log_linear_moments(&knots, c, *s);
+        let want = [want.0, want.1, want.2];
+        let scale = [want[0], want[0] * s, want[0] * s * s];
+        for k in 0..3 {
+            let g = f64::from(gpu[3 * i + k]);
+            assert!(g.is_finite(), "case {i} (s {s}) moment {k}: GPU gave {g}");
+            let err = (g - want[k]).abs() / scale[k].max(1e-30);
+            assert!(
+                err <= 2e-4,
+                "case {i} (s {s}) moment {k}: GPU {g:e}, core {:e}, error {err:.2e} of E[g]·s^{k}",
+                want[k]
+            );
+            worst = worst.max(err);
+        }
+    }
+    eprintln!("log_linear_moments: {n} cases, worst error {worst:.2e} of E[g]·s^k");
+    assert!(n >= 100);
+}
+
+/// Products of two weights from moments (one a power), their expectations under a full, a
+/// rank-one and a zero covariance, and their tilted Gaussians: the GPU against core.
+#[test]
+fn wgsl_gaussian_weights_match_core_on_the_adapter() {
+    let Some(ctx) = lodestone_tests::gpu("the GPU mirror test") else {
+        return;
+    };
+    // (e_a, moments a, e_b, moments b, power of b, mean, covariance root)
+    type Case = (DVec2, [f64; 3], DVec2, [f64; 3], f64, DVec2, DMat2);
+    let mut cases: Vec<Case> = vec![];
+    let roots = [
+        DMat2::from_cols(DVec2::new(0.7, 0.2), DVec2::new(0.0, 0.4)),
+        DMat2::from_cols(DVec2::new(0.5, -0.3), DVec2::ZERO),
+        DMat2::ZERO,
+        DMat2::IDENTITY,
+    ];
+    for (j, (ma, mb)) in [
+        ([0.7, -0.2, 0.5], [0.5, 0.15, 0.3]),
+        ([0.14, -0.13, 0.13], [0.88, 0.02, 0.9]),
+        ([0.999, 0.0, 0.999], [0.3, 0.25, 0.22]),
+        ([0.05, 0.045, 0.0406], [0.6, -0.3, 0.35]),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let ea = DVec2::from_angle(0.4 + j as f64);
+        let eb = DVec2::from_angle(2.9 - 0.7 * j as f64);
+        for (k, root) in roots.iter().enumerate() {
+            for power in [1.0, 0.6, 0.0] {
+                let mean = DVec2::new(0.3 - 0.2 * k as f64, -0.5 + 0.3 * j as f64);
+                cases.push((ea, ma, eb, mb, power, mean, *root));
+            }
+        }
+    }
+    // Core on the f32 inputs the GPU reads.
+    let r = |x: f64| f64::from(x as f32);
+    let cases: Vec<Case> = cases
+        .into_iter()
+        .map(|(ea, ma, eb, mb, p, mu, l)| {
+            let v = |v: DVec2| DVec2::new(r(v.x), r(v.y));
+            (
+                v(ea),
+                ma.map(r),
+                v(eb),
+                mb.map(r),
+                r(p),
+                v(mu),
+                DMat2::from_cols(v(l.x_axis), v(l.y_axis)),
+            )
+        })
+        .collect();
+    let n = cases.len();
+    let list = |f: &dyn Fn(&Case) -> String| cases.iter().map(f).collect::<Vec<_>>().join(", ");
+    let v2 = |v: DVec2| format!("vec2<f32>({:?}, {:?})", v.x as f32, v.y as f32);
+    let v3 = |v: [f64; 3]| format!("vec3<f32>({})", f32s(v));
+    let extra = format!(
+        "var<private> EA: array<vec2<f32>, {n}> = array({});\n\
+         var<private> MA: array<vec3<f32>, {n}> = array({});\n\
+         var<private> EB: array<vec2<f32>, {n}> = array({});\n\
+         var<private> MB: array<vec3<f32>, {n}> = array({});\n\
+         var<private> PW: array<f32, {n}> = array({});\n\
+         var<private> MU: array<vec2<f32>, {n}> = array({});\n\
+         var<private> L0: array<vec2<f32>, {n}> = array({});\n\
+         var<private> L1: array<vec2<f32>, {n}> = array({});\n\
+         fn run(x: f32) -> f32 {{\n\
+             let i = u32(x) / 6u;\n\
+             let a = gaussian_weight_along(EA[i], MA[i].x, MA[i].y, MA[i].z);\n\
+             let b = gaussian_weight_along(EB[i], MB[i].x, MB[i].y, MB[i].z);\n\
+             let w = gaussian_weight_mul(a, gaussian_weight_powf(b, PW[i]));\n\
+             let e = gaussian_weight_expect_under(w, MU[i], mat2x2<f32>(L0[i], L1[i]));\n\
+             let t = gaussian_weight_tilted(w);\n\
+             switch (u32(x) % 6u) {{\n\
+                 case 0u: {{ return select(-1.0, e.x, e.y > 0.0); }}\n\
+                 case 1u: {{ return select(-1.0, t.mass, t.ok); }}\n\
+                 case 2u: {{ return t.mean.x; }}\n\
+                 case 3u: {{ return t.mean.y; }}\n\
+                 case 4u: {{ return t.cov.x; }}\n\
+                 default: {{ return t.cov.y; }}\n\
+             }}\n\
+         }}\n",
+        list(&|c| v2(c.0)),
+        list(&|c| v3(c.1)),
+        list(&|c| v2(c.2)),
+        list(&|c| v3(c.3)),
+        list(&|c| format!("{:?}", c.4 as f32)),
+        list(&|c| v2(c.5)),
+        list(&|c| v2(c.6.x_axis)),
+        list(&|c| v2(c.6.y_axis)),
+    );
+    let xs: Vec<f32> = (0..6 * n).map(|i| i as f32).collect();
+    let gpu = eval_unary(&ctx, &library(&extra), "run", &xs);
+    let mut worst = 0.0f64;
+    for (i, (ea, ma, eb, mb, p, mu, l)) in cases.iter().enumerate() {
+        let a = GaussianWeight::along(*ea, ma[0], ma[1], ma[2]).expect("a");
+        let b = GaussianWeight::along(*eb, mb[0], mb[1], mb[2]).expect("b");
+        let w = a * b.powf(*p);
+        let g = |k: usize| f64::from(gpu[6 * i + k]);
+        let mut check = |k: usize, want: f64, scale: f64| {
+            let err = (g(k) - want).abs() / scale.max(1e-30);
+            assert!(
+                err <= 1e-4,
+                "case {i} output {k}: GPU {:e}, core {want:e}, error {err:.2e}",
+                g(k)
+            );
+            worst = worst.max(err);
+        };
+        match w.expect_under(*mu, *l) {
+            Some(e) => check(0, e, e),
+            None => assert_eq!(g(0), -1.0, "case {i}: core has no expectation"),
+        }
+        let Some((mass, mean, cov)) = w.tilted() else {
+            assert_eq!(g(1), -1.0, "case {i}: core has no tilt");
+            continue;
+        };
+        let spread = cov.x_axis.x.max(cov.y_axis.y).sqrt();
+        check(1, mass, mass);
+        check(2, mean.x, spread);
+        check(3, mean.y, spread);
+        check(4, cov.x_axis.x, spread * spread);
+        check(5, cov.x_axis.y, spread * spread);
+    }
+    eprintln!("gaussian weights: {n} cases, worst relative error {worst:.2e}");
+}
