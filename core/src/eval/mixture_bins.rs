@@ -53,6 +53,7 @@ use crate::microfacet::height_mixture::{
 };
 use crate::microfacet::masking_shadowing::G2;
 use crate::microfacet::slopes::SlopeCov;
+use crate::microfacet::visible_slopes::expected_positive_part;
 use glam::{DMat2, DMat3, DVec2, DVec3};
 
 use std::f64::consts::FRAC_1_PI;
@@ -262,16 +263,13 @@ impl Evaluator {
                 }
                 if let (true, Some(v2)) = (sun_lit, v2) {
                     let cov_q = d.gradient_cov.scaled(sigma_h * gd);
-                    let so_q = self
-                        .visible_shading_sums(
-                            mean_q,
-                            &cov_q,
-                            cfg.wo,
-                            cfg.wi,
-                            frame,
-                            conditioned_points,
-                        )
-                        .1;
+                    // Its visible projected area, in closed form (the rule's sum of weights).
+                    let so_q = expected_positive_part(
+                        cfg.wo.z,
+                        DVec2::new(cfg.wo.x, cfg.wo.y),
+                        mean_q,
+                        &cov_q,
+                    );
                     let lobe = self.specular_lobes(mean_q, &cov_q, cfg.wo, cfg.wi);
                     let mass = self
                         .lobe_visibility(rays, &v2, sigma_h * gd, (mean_q, &cov_q), cfg)
