@@ -8,7 +8,7 @@ use crate::gpu_types::{GpuStruct, MaterialParams};
 use lodestone_core::driver::conditional_slopes;
 use lodestone_core::driver::histogram::G_END;
 use lodestone_core::eval::lod_surface::LOD_SETTLE;
-use lodestone_core::eval::slope_masking_table;
+use lodestone_core::eval::{slope_masking_table, transfer_masking_table};
 use lodestone_core::math::{gaussian_weight, log_linear_moments};
 use lodestone_core::microfacet::effective_height::{
     FIT_ALPHA_MU, FIT_ALPHA_SIGMA, FIT_BETA_MU, FIT_BETA_SIGMA,
@@ -178,7 +178,15 @@ pub fn wgsl_prelude() -> &'static str {
             ("TABLE_NUS", slope_masking_table::TABLE_NUS as u32),
             (
                 "TRANSFER_SLOPE_NODES",
-                lodestone_core::eval::transfer_masking_table::SLOPE_NODES as u32,
+                transfer_masking_table::SLOPE_NODES as u32,
+            ),
+            (
+                "TRANSFER_VALUE_NODES",
+                transfer_masking_table::VALUE_NODES as u32,
+            ),
+            (
+                "TRANSFER_ENTRY",
+                transfer_masking_table::TRANSFER_ENTRY as u32,
             ),
             ("DATA_ROW", crate::renderer::DATA_ROW),
         ];
@@ -201,6 +209,16 @@ pub fn wgsl_prelude() -> &'static str {
             ("TABLE_NU_MIN", slope_masking_table::NU_MIN),
             ("TABLE_NU_RATIO", slope_masking_table::NU_RATIO),
             ("HEIGHT_NODE_DEPTH", -slope_masking::height_node(0)),
+            (
+                "TRANSFER_VALUE_FIRST",
+                transfer_masking_table::value_node(0),
+            ),
+            ("TRANSFER_VALUE_STEP", transfer_masking_table::VALUE_STEP),
+            (
+                "TRANSFER_SLOPE_FIRST",
+                transfer_masking_table::slope_node(0),
+            ),
+            ("TRANSFER_SLOPE_STEP", transfer_masking_table::SLOPE_STEP),
             (
                 "LOG_LINEAR_MIN_DEVIATION",
                 log_linear_moments::MIN_DEVIATION,

@@ -65,6 +65,7 @@ pub const MATERIAL_FILES: &[(&str, &str)] = wgsl_files![
     "eval/query.wgsl",
     "eval/shading.wgsl",
     "eval/slope_masking_table.wgsl",
+    "eval/transfer_masking_table.wgsl",
     "eval/slope_weights.wgsl",
     "eval/naive.wgsl",
     "eval/view_independent.wgsl",
