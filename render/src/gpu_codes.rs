@@ -8,8 +8,8 @@ use crate::gpu_types::{GpuStruct, MaterialParams};
 use lodestone_core::driver::conditional_slopes;
 use lodestone_core::driver::histogram::G_END;
 use lodestone_core::eval::lod_surface::LOD_SETTLE;
-use lodestone_core::eval::{slope_masking_table, transfer_masking_table};
-use lodestone_core::math::{gaussian_weight, log_linear_moments};
+use lodestone_core::eval::{slope_masking_table, transfer_masking_table, transfer_moments};
+use lodestone_core::math::gaussian_weight;
 use lodestone_core::microfacet::effective_height::{
     FIT_ALPHA_MU, FIT_ALPHA_SIGMA, FIT_BETA_MU, FIT_BETA_SIGMA,
 };
@@ -177,16 +177,16 @@ pub fn wgsl_prelude() -> &'static str {
             ("TABLE_LEVELS", slope_masking_table::TABLE_LEVELS as u32),
             ("TABLE_NUS", slope_masking_table::TABLE_NUS as u32),
             (
-                "TRANSFER_SLOPE_NODES",
-                transfer_masking_table::SLOPE_NODES as u32,
-            ),
-            (
                 "TRANSFER_VALUE_NODES",
                 transfer_masking_table::VALUE_NODES as u32,
             ),
             (
-                "TRANSFER_ENTRY",
-                transfer_masking_table::TRANSFER_ENTRY as u32,
+                "TRANSFER_LENGTH_NODES",
+                transfer_moments::LENGTH_NODES as u32,
+            ),
+            (
+                "TRANSFER_MOMENT_ENTRY",
+                transfer_moments::MOMENT_ENTRY as u32,
             ),
             ("DATA_ROW", crate::renderer::DATA_ROW),
         ];
@@ -214,19 +214,6 @@ pub fn wgsl_prelude() -> &'static str {
                 transfer_masking_table::value_node(0),
             ),
             ("TRANSFER_VALUE_STEP", transfer_masking_table::VALUE_STEP),
-            (
-                "TRANSFER_SLOPE_FIRST",
-                transfer_masking_table::slope_node(0),
-            ),
-            ("TRANSFER_SLOPE_STEP", transfer_masking_table::SLOPE_STEP),
-            (
-                "LOG_LINEAR_MIN_DEVIATION",
-                log_linear_moments::MIN_DEVIATION,
-            ),
-            (
-                "LOG_LINEAR_MAX_DEVIATION",
-                log_linear_moments::MAX_DEVIATION,
-            ),
             (
                 "GAUSSIAN_WEIGHT_MIN_VARIANCE",
                 gaussian_weight::MIN_VARIANCE,

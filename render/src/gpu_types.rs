@@ -319,6 +319,16 @@ gpu_struct! {
         cm_offset: u32 => "u32",
         /// 1 when the filtered view conditions masking on the slope (the table is present).
         cm_on: u32 => "u32",
+        /// Offset of the transfer curve's masking table conditioned on the driver's value and
+        /// slope (core's `eval::transfer_masking_table::TransferMaskingTable`: σ_f, the gradient
+        /// covariance xx, xy, yy, then the entries).
+        tm_offset: u32 => "u32",
+        /// 1 when the transfer mixture's bins take that table (`tm_offset` is set).
+        tm_on: u32 => "u32",
+        /// Offset of the slope rule the conditioned bins shade on (n × n nodes of x, y, weight).
+        tm_rule_offset: u32 => "u32",
+        /// n of that rule (core's `CONDITIONED_SLOPE_POINTS`, or the bins' own n when larger).
+        tm_points: u32 => "u32",
     }
 }
 

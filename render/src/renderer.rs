@@ -14,6 +14,7 @@ use lodestone_core::driver::field::{DriverField, TiledImage};
 use lodestone_core::driver::noise::SumOfSines;
 use lodestone_core::eval::Evaluator;
 use lodestone_core::eval::compiled::CompiledTransfer;
+use lodestone_core::eval::mixture_bins::CONDITIONED_SLOPE_POINTS;
 use lodestone_core::material::color_terms::CombineMode;
 use lodestone_core::material::colormap::linear_to_srgb;
 use lodestone_core::material::features::{Feature, FeatureSet};
@@ -819,6 +820,30 @@ pub fn material_data_for(
                     data.extend([z.x as f32, z.y as f32, *w as f32]);
                 }
                 mark(&data, start, "slope rule of the transfer mixture's bins");
+            }
+            if let Some(t) = &prepared.transfer_masking {
+                let start = data.len();
+                base.tm_offset = data.len() as u32;
+                base.tm_on = 1;
+                data.push(t.sigma_f as f32);
+                data.extend(t.gradient.map(|g| g as f32));
+                data.extend(&t.moments);
+                mark(
+                    &data,
+                    start,
+                    "transfer curve's value- and slope-conditioned masking moments",
+                );
+                let tn = n.max(CONDITIONED_SLOPE_POINTS);
+                base.tm_points = tn as u32;
+                base.tm_rule_offset = base.mix_rule_offset;
+                if tn != n {
+                    let start = data.len();
+                    base.tm_rule_offset = data.len() as u32;
+                    for (z, w) in slope_rule(tn) {
+                        data.extend([z.x as f32, z.y as f32, *w as f32]);
+                    }
+                    mark(&data, start, "slope rule of the conditioned bins");
+                }
             }
         }
     }

@@ -29,7 +29,6 @@ pub const MATERIAL_FILES: &[(&str, &str)] = wgsl_files![
     "math/gaussian.wgsl",
     "math/bessel.wgsl",
     "math/piecewise.wgsl",
-    "math/log_linear_moments.wgsl",
     "math/gaussian_weight.wgsl",
     "microfacet/slopes.wgsl",
     "microfacet/smith.wgsl",

@@ -1,17 +1,13 @@
-//! The WGSL mirrors of #17's conditioned visibility (`math/log_linear_moments.wgsl`,
-//! `math/gaussian_weight.wgsl`, `eval/transfer_masking_table.wgsl`) against lodestone-core's f64 on
-//! the GPU adapter: the exact Gaussian moments of real columns of the terraces table and of a
-//! column that falls by 30 in one cell; the Gaussian weights' products, powers, expectations and
-//! tilts; and the table's rays and visibility weights over views, lights and values.
+//! The WGSL mirrors of #17's conditioned visibility (`math/gaussian_weight.wgsl`,
+//! `eval/transfer_masking_table.wgsl`) against lodestone-core's f64 on the GPU adapter: the
+//! Gaussian weights' products, powers, expectations and tilts, and the table's rays and visibility
+//! weights over views, lights and values.
 
 use glam::{DMat2, DVec2};
-use lodestone_core::eval::transfer_masking_table::{
-    SLOPE_NODES, TransferMaskingTable, entry_at, slope_node,
-};
+use lodestone_core::eval::transfer_masking_table::TransferMaskingTable;
 use lodestone_core::material::Material;
 use lodestone_core::material::features::FeatureSet;
 use lodestone_core::math::gaussian_weight::GaussianWeight;
-use lodestone_core::math::log_linear_moments::log_linear_moments;
 use lodestone_render::{compute::eval_unary, gpu_codes, shaders};
 
 /// The mirrored files with what they need (the constants prelude, the special functions, the
@@ -21,7 +17,6 @@ use lodestone_render::{compute::eval_unary, gpu_codes, shaders};
 fn library(extra: &str) -> String {
     let files = [
         include_str!("../src/shaders/math/gaussian.wgsl"),
-        include_str!("../src/shaders/math/log_linear_moments.wgsl"),
         include_str!("../src/shaders/math/gaussian_weight.wgsl"),
         include_str!("../src/shaders/microfacet/slopes.wgsl"),
         include_str!("../src/shaders/microfacet/smith.wgsl"),
@@ -42,88 +37,6 @@ fn f32s(v: impl IntoIterator<Item = f64>) -> String {
         .map(|x| format!("{:?}", x as f32))
         .collect::<Vec<_>>()
         .join(", ")
-}
-
-/// Columns of the terraces table (eye at 60°, 75° and 85°, every fourth value node) and a
-/// synthetic back face, each under deviations from a tenth of a cell to 3 (a projection of the
-/// footprint's whitened slopes is at most about 1) and a point: the GPU's (E[g], E[t g], E[t² g])
-/// against core's, relative to E[g]·(1, s, s²). Measured worst 1.8e-5; at s = 25, E[t² g]
-/// cancels to 1.6e-3 in f32.
-#[test]
-fn wgsl_log_linear_moments_match_core_on_the_adapter() {
-    let Some(ctx) = lodestone_tests::gpu("the GPU mirror test") else {
-        return;
-    };
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../presets/terraces.ron"
-    ))
-    .expect("terraces preset");
-    let m = Material::from_ron(&text).expect("terraces");
-    let table = TransferMaskingTable::shared(&m.noise().expect("noise"), &m.heights.transfer)
-        .expect("a table");
-    let knots: Vec<f64> = (0..SLOPE_NODES).map(slope_node).collect();
-    let mut columns: Vec<Vec<f64>> = vec![];
-    for nu in [0.15, 0.6, 1.7] {
-        let entry = table.lookup(DVec2::new(0.8, 0.6), nu);
-        for x in [-3.0, -1.5, -0.4, 0.3, 1.2, 2.5] {
-            columns.push(knots.iter().map(|t| entry_at(&entry, x, *t)).collect());
-        }
-    }
-    columns.push(
-        knots
-            .iter()
-            .map(|t| if *t < 1.0 { -0.1 * (t + 4.0) } else { -30.0 })
-            .collect(),
-    );
-    let deviations = [0.05, 0.3, 0.8, 1.0, 1.4, 3.0, 0.0];
-    let mut cases = vec![];
-    for c in &columns {
-        // Core on the f32 values the GPU reads.
-        let c32: Vec<f64> = c.iter().map(|v| f64::from(*v as f32)).collect();
-        for s in deviations {
-            cases.push((c32.clone(), s));
-        }
-    }
-    let n = cases.len();
-    let extra = format!(
-        "var<private> COLUMNS: array<array<f32, {SLOPE_NODES}>, {n}> = array({});\n\
-         var<private> DEVIATIONS: array<f32, {n}> = array({});\n\
-         fn run(x: f32) -> f32 {{\n\
-             let i = u32(x) / 3u;\n\
-             let m = log_linear_moments(COLUMNS[i], {:?}, {:?}, DEVIATIONS[i]);\n\
-             return m[u32(x) % 3u];\n\
-         }}\n",
-        cases
-            .iter()
-            .map(|(c, _)| format!("array<f32, {SLOPE_NODES}>({})", f32s(c.iter().copied())))
-            .collect::<Vec<_>>()
-            .join(",\n"),
-        f32s(cases.iter().map(|c| c.1)),
-        slope_node(0) as f32,
-        (slope_node(1) - slope_node(0)) as f32,
-    );
-    let xs: Vec<f32> = (0..3 * n).map(|i| i as f32).collect();
-    let gpu = eval_unary(&ctx, &library(&extra), "run", &xs);
-    let mut worst = 0.0f64;
-    for (i, (c, s)) in cases.iter().enumerate() {
-        let want = log_linear_moments(&knots, c, *s);
-        let want = [want.0, want.1, want.2];
-        let scale = [want[0], want[0] * s, want[0] * s * s];
-        for k in 0..3 {
-            let g = f64::from(gpu[3 * i + k]);
-            assert!(g.is_finite(), "case {i} (s {s}) moment {k}: GPU gave {g}");
-            let err = (g - want[k]).abs() / scale[k].max(1e-30);
-            assert!(
-                err <= 2e-4,
-                "case {i} (s {s}) moment {k}: GPU {g:e}, core {:e}, error {err:.2e} of E[g]·s^{k}",
-                want[k]
-            );
-            worst = worst.max(err);
-        }
-    }
-    eprintln!("log_linear_moments: {n} cases, worst error {worst:.2e} of E[g]·s^k");
-    assert!(n >= 100);
 }
 
 /// Products of two weights from moments (one a power), their expectations under a full, a
@@ -250,7 +163,7 @@ fn wgsl_gaussian_weights_match_core_on_the_adapter() {
     eprintln!("gaussian weights: {n} cases, worst relative error {worst:.2e}");
 }
 
-/// The terraces table in the harness's input buffer (σ_f, the gradient covariance, the entries),
+/// The terraces table in the harness's input buffer (σ_f, the gradient covariance, the moments),
 /// then the table's rays for views 0–85° and lights along, across and opposite (one below the
 /// horizon) on a far and a nearer footprint, and each ray's weights at nine driver values: the
 /// GPU's masses and tilts against core's `TransferRays::visibility_weights`.
@@ -275,7 +188,7 @@ fn wgsl_transfer_rays_match_core_on_the_adapter() {
     let r = |x: f64| f64::from(x as f32);
     let mut data: Vec<f32> = vec![table.sigma_f as f32];
     data.extend(table.gradient.map(|g| g as f32));
-    data.extend(&table.data);
+    data.extend(&table.moments);
     // Core on the f32 header the GPU reads.
     let mut t32 = (*table).clone();
     t32.sigma_f = r(t32.sigma_f);

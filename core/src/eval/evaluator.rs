@@ -14,6 +14,7 @@ use crate::material::Material;
 use crate::material::environment::EquirectMap;
 use crate::material::measured::{ChannelWeights, MeasuredBrdf};
 use crate::material::slope_color::CompiledSlopeColor;
+use crate::material::transfer::TransferFunction;
 use crate::math::sh::Sh9;
 use crate::microfacet::slope_masking::SlopeMasking;
 use crate::scene::surface::Surface;
@@ -49,8 +50,8 @@ pub struct Evaluator {
     /// (`filtering.slope_masking`, [`crate::eval::slope_masking_table`]).
     pub slope_masking: Option<Arc<SlopeMaskingTable>>,
     /// The transfer mixture's masking conditioned on the driver's value and slope
-    /// ([`crate::eval::transfer_masking_table`]): a CPU prototype that [`Evaluator::new`] does
-    /// not build (the views do not have it yet); a measurement sets it to compare.
+    /// ([`crate::eval::transfer_masking_table`]): built for a noise driver under a transfer curve
+    /// when `filtering.slope_masking` is conditioned (Smith's bins otherwise).
     pub transfer_masking: Option<Arc<TransferMaskingTable>>,
 }
 
@@ -134,6 +135,23 @@ impl Evaluator {
                 .or_else(|| SlopeMaskingTable::shared(noise)),
             _ => None,
         };
+        // The transfer mixture's masking conditioned on the driver's value and slope: a noise
+        // driver's, under a transfer curve, with the masking conditioned.
+        let transfer_masking = match (material.filtering.slope_masking, &surface.driver) {
+            (SlopeMasking::Conditioned, DriverField::Noise(noise))
+                if material.transfer_mixture()
+                    && matches!(material.heights.transfer, TransferFunction::Curve(_)) =>
+            {
+                previous
+                    .filter(|p| {
+                        p.material.driver == material.driver
+                            && p.material.heights.transfer == material.heights.transfer
+                    })
+                    .and_then(|p| p.transfer_masking.clone())
+                    .or_else(|| TransferMaskingTable::shared(noise, &material.heights.transfer))
+            }
+            _ => None,
+        };
         let g = material.heights.transfer.moments(0.0, 1.0);
         let environment = match previous {
             Some(p) if p.material.lighting == material.lighting => p.environment,
@@ -150,7 +168,7 @@ impl Evaluator {
             environment,
             measured: None,
             slope_masking,
-            transfer_masking: None,
+            transfer_masking,
         })
     }
 

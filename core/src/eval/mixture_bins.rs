@@ -21,22 +21,21 @@
 //! the moss, sponge and terraces presets: within 0.1%, 0.8% and 3.0% (terraces at 75°; a riser
 //! whose g′ runs from 0 to its peak inside one bin is still one Gaussian).
 //!
-//! **Conditioned on the driver's slope (CPU prototype, #17).** With
-//! [`Evaluator::transfer_masking`] set (only measurements set it), each bin is also summed over
+//! **Conditioned on the driver's slope (#17).** With [`Evaluator::transfer_masking`] set (a
+//! noise driver under a transfer curve with conditioned masking), each bin is also summed over
 //! its [`BIN_SAMPLES`] sub-values, each with its own g′ and its own visibility (a riser and a tread
 //! in one bin are two slope scales, not their root mean square). Its conditioned G1 along ωo and
 //! joint masking–shadowing over the driver's slopes
 //! ([`crate::eval::transfer_masking_table::TransferRays::visibility_weights`]: each ray's from its
-//! own 1-D moments, their joint term in closed form) are Gaussian functions of the slopes: each
+//! 1-D moments in the table, their joint term in closed form) are Gaussian functions of the slopes: each
 //! reweights the slopes' Gaussian into another ([`GaussianWeight::tilted`]), which the bin shades
 //! as it shades any Gaussian of slopes (within 0.9% of summing shading and visibility node by
 //! node on #17's grid). Each sub-value's specular lobe is widened by its own slopes and takes the
 //! joint term's mean over its half-vector posterior, in closed form
 //! ([`Evaluator::lobe_visibility`]). The two are blended by the
 //! footprint's far weight (docs/design.md, "Transfer curves: masking that knows the driver's
-//! slope"). On #17's grid terraces' worst excess is 1.93% (0–60°) and 2.07% (75–85°), where
-//! Smith's bins have 5.06% and 14.46% (one Gaussian per bin with the conditioned visibility had
-//! 3.63% and 4.34%).
+//! slope"). On #17's grid terraces' worst excess is 2.69% (0–60°) and 1.32% (75–85°), where
+//! Smith's bins have 5.06% and 14.46%; sponge 0.24% and 4.52% (Smith's 2.10% and 13.43%).
 
 use crate::driver::conditional_slopes::ImageSlopes;
 use crate::eval::query::FootprintStats;
@@ -59,11 +58,11 @@ use glam::{DMat2, DMat3, DVec2, DVec3};
 use std::f64::consts::FRAC_1_PI;
 
 /// n of the polar rule (n² nodes) over a sub-value's slopes when its masking is conditioned on
-/// the driver's slope ([`crate::eval::transfer_masking_table`]): the visibility's reweighting
-/// tilts and narrows the slopes' Gaussian within 1σ over a tread, where the shading alone would
-/// need few nodes. On #17's grid 6 is as good as 8 (terraces 1.98% / 1.95% against 2.01% /
-/// 1.98%, at 4.5× Smith's bins' time instead of 6.4×); 4 is not (3.38% up to 60°).
-pub const CONDITIONED_SLOPE_POINTS: usize = 6;
+/// the driver's slope ([`crate::eval::transfer_masking_table`]), at least: the bins' own 4 × 4.
+/// On #17's grid 6 × 6 gave terraces 2.66% / 1.19%, sponge 0.00% / 4.39% and moss 0 / 0, and 4 × 4
+/// gives 2.69% / 1.32%, 0.24% / 4.52% and 0.05% / 0.21%, at 1868 instead of 2260 ms a frame on
+/// llvmpipe (terraces, 256 × 192; Smith's bins 774).
+pub const CONDITIONED_SLOPE_POINTS: usize = 4;
 
 /// What a bin of the driver's value contributes: its mean g′, the root mean square of g′ and the
 /// mean point colour.
@@ -233,7 +232,7 @@ impl Evaluator {
             let mut spec = [0.0f64; 3];
             for q in 0..BIN_SAMPLES {
                 let xq = rays.value_at(lo + (hi - lo) * (q as f64 + 0.5) * ks);
-                let gd = m.heights.transfer.derivative(xq);
+                let gd = m.heights.transfer.derivative(rays.driver_value(xq));
                 let mean_q = d.mean_gradient * (sigma_h * gd);
                 // The conditioned visibility as a reweighting of the driver slopes' Gaussian,
                 // shaded as the bins shade any Gaussian of slopes.

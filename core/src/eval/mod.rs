@@ -48,6 +48,7 @@ pub mod shading;
 pub mod slope_masking_table;
 pub mod slope_weights;
 pub mod transfer_masking_table;
+pub mod transfer_moments;
 pub mod truth_prediction;
 pub mod view_independent;
 

@@ -1,15 +1,15 @@
-// Mirror of `core/src/eval/transfer_masking_table.rs`: a transfer-curve material's table of ln G1
-// conditioned on the driver's value and slope (#17), at `base` in the material's data: σ_f, the
-// driver's global gradient covariance (xx, xy, yy), then TABLE_AZIMUTHS × TABLE_NUS entries
-// (ν fastest) of TRANSFER_VALUE_NODES × TRANSFER_SLOPE_NODES stored values (value-major),
-// `ln max(−ln G1, MIN_EXPONENT)`. Reads are on demand: a ray keeps its four (azimuth, ν) entries
-// and their weights instead of core's interpolated entry.
+// Mirror of `core/src/eval/transfer_masking_table.rs` and `transfer_moments.rs`: a transfer-curve
+// material's masking conditioned on the driver's value and slope (#17), as the Gaussian moments
+// of its columns, at `base` in the material's data: σ_f, the driver's global gradient covariance
+// (xx, xy, yy), then TABLE_AZIMUTHS × TABLE_NUS moment blocks (ν fastest) of
+// TRANSFER_VALUE_NODES × TRANSFER_LENGTH_NODES × (E[g], E[a g], E[a² g]). Reads are on demand: a
+// ray keeps its four (azimuth, ν) blocks and their weights instead of core's blended block.
 // `//#if feature` blocks are stripped by render/src/specialize.rs when a scene does not use the feature.
 
 //#if transfer_mixture
-// One ray against the table (core's RayMasking): the entries (a0 n0, a0 n1, a1 n0, a1 n1) it
-// blends, their weights, its ν and the projection of the footprint's whitened driver gradient on
-// its azimuth (σ units of the table).
+// One ray against the table (core's RayMasking): the moment blocks (a0 n0, a0 n1, a1 n0, a1 n1)
+// it blends, their weights, its ν and the projection of the footprint's whitened driver gradient
+// on its azimuth (σ units of the table).
 struct TransferRay {
     entries: vec4<u32>,
     weights: vec4<f32>,
@@ -97,10 +97,10 @@ fn transfer_ray(base: u32, w: vec3<f32>, chol: vec3<f32>, sigma_h: f32) -> Trans
     let fnu = nv - f32(n0);
     let e = base + 4u;
     ray.entries = vec4<u32>(
-        e + (a0 * TABLE_NUS + n0) * TRANSFER_ENTRY,
-        e + (a0 * TABLE_NUS + n0 + 1u) * TRANSFER_ENTRY,
-        e + (a1 * TABLE_NUS + n0) * TRANSFER_ENTRY,
-        e + (a1 * TABLE_NUS + n0 + 1u) * TRANSFER_ENTRY,
+        e + (a0 * TABLE_NUS + n0) * TRANSFER_MOMENT_ENTRY,
+        e + (a0 * TABLE_NUS + n0 + 1u) * TRANSFER_MOMENT_ENTRY,
+        e + (a1 * TABLE_NUS + n0) * TRANSFER_MOMENT_ENTRY,
+        e + (a1 * TABLE_NUS + n0 + 1u) * TRANSFER_MOMENT_ENTRY,
     );
     ray.weights = vec4<f32>((1.0 - fa) * (1.0 - fnu), (1.0 - fa) * fnu, fa * (1.0 - fnu), fa * fnu);
     return ray;
@@ -134,38 +134,38 @@ fn transfer_rays_new(
     return rays;
 }
 
-// transfer_lookup: ln G1 of the ray at value node i and slope node j, its four entries' stored values
-// blended and mapped back (−exp).
-fn transfer_lookup(ray: TransferRay, i: u32, j: u32) -> f32 {
-    let o = i * TRANSFER_SLOPE_NODES + j;
-    var q = 0.0;
-    for (var c = 0u; c < 4u; c = c + 1u) {
-        let w = ray.weights[c];
-        if (w != 0.0) {
-            q = q + w * datum(ray.entries[c] + o);
-        }
-    }
-    return -exp(q);
+// length_cell: the length nodes k, k + 1 around len and the weight of k + 1, clamped to [0, 1].
+fn length_cell(len: f32) -> vec2<f32> {
+    let step = 1.0 / f32(TRANSFER_LENGTH_NODES - 1u);
+    let u = clamp(len / step, 0.0, f32(TRANSFER_LENGTH_NODES - 1u));
+    let k = min(u32(u), TRANSFER_LENGTH_NODES - 2u);
+    return vec2<f32>(f32(k), u - f32(k));
 }
 
-// transfer_entry_at: ln G1 of the ray at driver value x and slope t (both in σ), bilinear, clamped.
-fn transfer_entry_at(ray: TransferRay, x: f32, t: f32) -> f32 {
+// moments_at: (E[g], E[a g], E[a² g]) of the ray at driver value x (global σ) and projection
+// length len, its four blocks blended, bilinear in the value and the length.
+fn moments_at(ray: TransferRay, x: f32, len: f32) -> vec3<f32> {
     let ci = node_cell(x, TRANSFER_VALUE_FIRST, TRANSFER_VALUE_STEP, TRANSFER_VALUE_NODES);
-    let cj = node_cell(t, TRANSFER_SLOPE_FIRST, TRANSFER_SLOPE_STEP, TRANSFER_SLOPE_NODES);
+    let ck = length_cell(len);
     let i = u32(ci.x);
-    let j = u32(cj.x);
-    var lo = transfer_lookup(ray, i, j) * (1.0 - cj.y);
-    var hi = transfer_lookup(ray, i + 1u, j) * (1.0 - cj.y);
-    if (cj.y != 0.0) {
-        lo = lo + transfer_lookup(ray, i, j + 1u) * cj.y;
-        hi = hi + transfer_lookup(ray, i + 1u, j + 1u) * cj.y;
+    let k = u32(ck.x);
+    var m = vec3<f32>(0.0);
+    for (var c = 0u; c < 16u; c = c + 1u) {
+        let corner = c & 3u;
+        let di = (c >> 2u) & 1u;
+        let dk = (c >> 3u) & 1u;
+        let w = ray.weights[corner] * select(1.0 - ci.y, ci.y, di == 1u) * select(1.0 - ck.y, ck.y, dk == 1u);
+        if (w != 0.0) {
+            let o = ray.entries[corner] + ((i + di) * TRANSFER_LENGTH_NODES + k + dk) * 3u;
+            m = m + w * vec3<f32>(datum(o), datum(o + 1u), datum(o + 2u));
+        }
     }
-    return lo * (1.0 - ci.y) + hi * ci.y;
+    return m;
 }
 
 // TransferRays::ray_weight: the conditioned G1 of the eye's ray (the light's when `light`) at
-// driver value x as a Gaussian function of the whitened driver slopes, its moments exact on the
-// column at x; ok = false with the sun down or nothing visible.
+// driver value x as a Gaussian function of the whitened driver slopes, from the table's moments;
+// ok = false with the sun down or nothing visible.
 fn ray_weight(rays: TransferRays, x: f32, light: bool) -> GaussianWeight {
     var r = rays.o;
     if (light) {
@@ -179,18 +179,8 @@ fn ray_weight(rays: TransferRays, x: f32, light: bool) -> GaussianWeight {
     if (len > 1e-12) {
         e = r.projection / len;
     }
-    // The column at x: at the slope nodes the slope weight is 0, so two value nodes a node.
-    let ci = node_cell(x, TRANSFER_VALUE_FIRST, TRANSFER_VALUE_STEP, TRANSFER_VALUE_NODES);
-    let i = u32(ci.x);
-    var column: array<f32, TRANSFER_SLOPE_NODES>;
-    for (var j = 0u; j < TRANSFER_SLOPE_NODES; j = j + 1u) {
-        column[j] = transfer_lookup(r, i, j) * (1.0 - ci.y) + transfer_lookup(r, i + 1u, j) * ci.y;
-    }
-    let m = log_linear_moments(column, TRANSFER_SLOPE_FIRST, TRANSFER_SLOPE_STEP, len);
-    if (len > LOG_LINEAR_MIN_DEVIATION) {
-        return gaussian_weight_along(e, m.x, m.y / len, m.z / (len * len));
-    }
-    return gaussian_weight_along(e, m.x, 0.0, m.x);
+    let m = moments_at(r, x, len);
+    return gaussian_weight_along(e, m.x, m.y, m.z);
 }
 
 // TransferRays::visibility_weights: the eye's G1 and the joint term lo·hi^k as Gaussian
