@@ -408,14 +408,22 @@ impl TransferRays {
             Correlation::HeightDirection => azimuth_factor(azimuth_difference(wo, wi)),
         };
         let sf = table.sigma_f.max(1e-300);
+        let (o, i) = (ray(wo), sun_lit.then(|| ray(wi)));
+        // A ray flatter than the table's first ν node is outside it (clamped there, the bins
+        // came out 24% dark at 89° on moss): Smith's bins take it.
+        let inside = o.nu >= NU_MIN && i.as_ref().is_none_or(|i| i.nu >= NU_MIN);
         Self {
             chol: (l11, l21, l22),
-            o: ray(wo),
-            i: sun_lit.then(|| ray(wi)),
+            o,
+            i,
             k,
             mean: d.mean / sf,
             std: d.std / sf,
-            far: far_weight(d.std, table.sigma_f),
+            far: if inside {
+                far_weight(d.std, table.sigma_f)
+            } else {
+                0.0
+            },
             sigma_f: sf,
         }
     }

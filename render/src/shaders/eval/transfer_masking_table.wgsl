@@ -131,6 +131,10 @@ fn transfer_rays_new(
     rays.mean = d.mean / sf;
     rays.std_dev = d.std_dev / sf;
     rays.far = far_weight(d.std_dev, datum(base));
+    // A ray flatter than the table's first ν node is outside it: Smith's bins take it.
+    if (rays.o.nu < TABLE_NU_MIN || (sun_lit && rays.i.nu < TABLE_NU_MIN)) {
+        rays.far = 0.0;
+    }
     return rays;
 }
 
