@@ -186,7 +186,7 @@ pub fn wgsl_prelude() -> &'static str {
             ),
             (
                 "TRANSFER_MOMENT_ENTRY",
-                transfer_moments::MOMENT_ENTRY as u32,
+                transfer_masking_table::MOMENT_ENTRY as u32,
             ),
             ("DATA_ROW", crate::renderer::DATA_ROW),
         ];

@@ -45,6 +45,9 @@ pub const SLOPE_NODES: usize = 17;
 pub const SLOPE_STEP: f64 = 0.5;
 /// f32 values per entry, value-major.
 pub const TRANSFER_ENTRY: usize = VALUE_NODES * SLOPE_NODES;
+/// f32 values per entry of the moments ([`transfer_moments`]): value-major, then the projection
+/// length, then the three moments.
+pub const MOMENT_ENTRY: usize = VALUE_NODES * transfer_moments::LENGTH_NODES * 3;
 
 /// Driver slope of node `j` (σ units along the ray).
 pub fn slope_node(j: usize) -> f64 {
@@ -86,7 +89,7 @@ pub struct TransferMaskingTable {
     pub gradient: [f64; 3],
     /// `TRANSFER_ENTRY` values per (azimuth, ν), ν fastest.
     pub data: Vec<f32>,
-    /// The entries' Gaussian moments ([`crate::eval::transfer_moments`]): `MOMENT_ENTRY`
+    /// The entries' Gaussian moments ([`crate::eval::transfer_moments`]): [`MOMENT_ENTRY`]
     /// values per (azimuth, ν), ν fastest.
     pub moments: Vec<f32>,
 }
@@ -183,7 +186,8 @@ impl TransferMaskingTable {
             .par_chunks(TRANSFER_ENTRY)
             .flat_map_iter(|e| {
                 let entry: Vec<f64> = e.iter().map(|q| -f64::from(*q).exp()).collect();
-                transfer_moments::entry_moments(&entry)
+                let knots: Vec<f64> = (0..SLOPE_NODES).map(slope_node).collect();
+                transfer_moments::entry_moments(&entry, &knots)
             })
             .collect();
         Some(Self {
@@ -224,13 +228,13 @@ impl TransferMaskingTable {
         acc.map(|q| -q.exp())
     }
 
-    /// The moment block ([`transfer_moments::MOMENT_ENTRY`] values) of a ray of horizontal
+    /// The moment block ([`MOMENT_ENTRY`] values) of a ray of horizontal
     /// direction `dir` and slope `nu`: the entries' moments, linear in the azimuth and ln ν
     /// with [`TransferMaskingTable::lookup`]'s weights.
     pub fn moment_lookup(&self, dir: DVec2, nu: f64) -> Vec<f64> {
         let (a0, a1, fa) = azimuth_coordinate(dir);
         let (n0, fnu) = nu_coordinate(nu);
-        let size = transfer_moments::MOMENT_ENTRY;
+        let size = MOMENT_ENTRY;
         let mut acc = vec![0.0f64; size];
         for (a, wa) in [(a0, 1.0 - fa), (a1, fa)] {
             for (n, wn) in [(n0, 1.0 - fnu), (n0 + 1, fnu)] {
@@ -442,7 +446,7 @@ impl TransferRays {
         } else {
             DVec2::X
         };
-        let [m0, m1, m2] = transfer_moments::moments_at(&r.moments, x, len);
+        let [m0, m1, m2] = transfer_moments::moments_at(&r.moments, value_cell(x), len);
         GaussianWeight::along(e, m0, m1, m2)
     }
 
