@@ -210,8 +210,8 @@ pub fn wgsl_prelude() -> &'static str {
             ("TABLE_NU_RATIO", slope_masking_table::NU_RATIO),
             ("HEIGHT_NODE_DEPTH", -slope_masking::height_node(0)),
             (
-                "TRANSFER_VALUE_FIRST",
-                transfer_masking_table::value_node(0),
+                "TRANSFER_VALUE_DEPTH",
+                -transfer_masking_table::value_node(0),
             ),
             ("TRANSFER_VALUE_STEP", transfer_masking_table::VALUE_STEP),
             (

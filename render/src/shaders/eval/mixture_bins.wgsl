@@ -195,7 +195,7 @@ fn conditioned_bin(rays: TransferRays, d: FilteredDriver, lo: f32, hi: f32, wo_w
             b.s2 = shading_add(b.s2, j.sums.s, ks * j.mass);
             s2o_q = j.mass * j.sums.den;
         }
-//#if specular|measured
+//#if specular
         if (sun_lit && w.joint.ok) {
             let cov_q = d.gradient_cov * (params.sigma_h * gd * params.sigma_h * gd);
             let so_q = expected_positive_part(wo_w.z, wo_w.xy, mean_q, cov_q);
@@ -217,7 +217,7 @@ fn shading_add(a: SlopeShading, s: SlopeShading, w: f32) -> SlopeShading {
     return SlopeShading(a.cos + w * s.cos, a.cs_cos + w * s.cs_cos, a.env + w * s.env, a.cs_env + w * s.cs_env);
 }
 
-//#if specular|measured
+//#if specular
 // Evaluator::lobe_visibility: the joint term's mean over the lobe's half-vector posterior, in
 // closed form, as (value, 1), or (0, 0) where there is no slope to select the facets by.
 fn lobe_visibility(rays: TransferRays, v2: GaussianWeight, scale: f32, mean: vec2<f32>, cov: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>) -> vec2<f32> {

@@ -149,7 +149,7 @@ fn length_cell(len: f32) -> vec2<f32> {
 // moments_at: (E[g], E[a g], E[a² g]) of the ray at driver value x (global σ) and projection
 // length len, its four blocks blended, bilinear in the value and the length.
 fn moments_at(ray: TransferRay, x: f32, len: f32) -> vec3<f32> {
-    let ci = node_cell(x, TRANSFER_VALUE_FIRST, TRANSFER_VALUE_STEP, TRANSFER_VALUE_NODES);
+    let ci = node_cell(x, -TRANSFER_VALUE_DEPTH, TRANSFER_VALUE_STEP, TRANSFER_VALUE_NODES);
     let ck = length_cell(len);
     let i = u32(ci.x);
     let k = u32(ck.x);
