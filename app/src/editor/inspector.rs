@@ -140,7 +140,18 @@ impl Inspector {
                             "Through g: heights skewness {:.2}, excess kurtosis {:.2}; slopes excess kurtosis {:.2} (0 for a Gaussian)",
                             sh.skewness, sh.excess_kurtosis, sh.slope_excess_kurtosis
                         ));
-                        if sh.far_from_gaussian() {
+                        // The transfer mixture's masking conditioned on the driver's value and
+                        // slope (#17): a noise driver with conditioned masking.
+                        let conditioned = matches!(m.driver, Driver::Noise(_))
+                            && m.transfer_mixture()
+                            && m.filtering.slope_masking == SlopeMasking::Conditioned;
+                        if sh.far_from_gaussian() && conditioned && !(m.terms.slope.is_some() || m.lighting.environment.is_some()) {
+                            ui.label(
+                                "Far from Gaussian: the filtered view's bins follow the curve and condition their masking \
+                                 on the driver's value and slope [#17]; past 85° from the normal expect a few % \
+                                 (Filtering, Slope masking: Smith is the faster path).",
+                            );
+                        } else if sh.far_from_gaussian() {
                             let slope_terms = m.terms.slope.is_some() || m.lighting.environment.is_some();
                             ui.colored_label(
                                 ui.visuals().warn_fg_color,

@@ -776,6 +776,12 @@ fn transfer_curve_shape_and_warning_are_shown() {
     h.step();
     h.step();
     h.get_by_label_contains("Through g: heights skewness");
+    h.get_by_label_contains("Far from Gaussian: the filtered view's bins follow the curve");
+    // With Smith's masking the filtered view assumes Gaussian statistics, and says so.
+    h.state_mut().doc.material.filtering.slope_masking =
+        lodestone_core::microfacet::slope_masking::SlopeMasking::Smith;
+    h.step();
+    h.step();
     h.get_by_label_contains("Far from Gaussian: the filtered view's masking");
     // The identity has nothing to report.
     h.state_mut().open_path(&ctx, &preset("default.ron"));
