@@ -796,10 +796,7 @@ pub fn material_data_for(
         }
         mark(&data, start, "visible-height table D_h");
         let start = data.len();
-        lay.slope_rule = data.len() as u32;
-        for (z, w) in slope_rule(points) {
-            data.extend([z.x as f32, z.y as f32, *w as f32]);
-        }
+        lay.slope_rule = push_rule(&mut data, points);
         mark(&data, start, "slope quadrature rule");
         if let Some(t) = &prepared.slope_masking {
             let start = data.len();
@@ -815,10 +812,7 @@ pub fn material_data_for(
             base.mix_rule_offset = lay.slope_rule;
             if n != points {
                 let start = data.len();
-                base.mix_rule_offset = data.len() as u32;
-                for (z, w) in slope_rule(n) {
-                    data.extend([z.x as f32, z.y as f32, *w as f32]);
-                }
+                base.mix_rule_offset = push_rule(&mut data, n);
                 mark(&data, start, "slope rule of the transfer mixture's bins");
             }
             if let Some(t) = &prepared.transfer_masking {
@@ -838,10 +832,7 @@ pub fn material_data_for(
                 base.tm_rule_offset = base.mix_rule_offset;
                 if tn != n {
                     let start = data.len();
-                    base.tm_rule_offset = data.len() as u32;
-                    for (z, w) in slope_rule(tn) {
-                        data.extend([z.x as f32, z.y as f32, *w as f32]);
-                    }
+                    base.tm_rule_offset = push_rule(&mut data, tn);
                     mark(&data, start, "slope rule of the conditioned bins");
                 }
             }
@@ -978,6 +969,15 @@ pub fn material_data_for(
         params: base,
         segments,
     }
+}
+
+/// Append the n × n slope rule ([`slope_rule`]: x, y, weight per node) and return its offset.
+fn push_rule(data: &mut Vec<f32>, n: usize) -> u32 {
+    let offset = data.len() as u32;
+    for (z, w) in slope_rule(n) {
+        data.extend([z.x as f32, z.y as f32, *w as f32]);
+    }
+    offset
 }
 
 /// The noise driver the octave march sums, when the march is fast, the scene has relief and σ_h > 0:

@@ -11,7 +11,8 @@ use lodestone_core::math::gaussian_weight::GaussianWeight;
 use lodestone_render::{compute::eval_unary, gpu_codes, shaders};
 
 /// The mirrored files with what they need (the constants prelude, the special functions, the
-/// Cholesky factor, Smith's masking for the azimuth factor, the footprint's driver), specialized
+/// Cholesky factor, Smith's masking for the azimuth factor, the footprint's driver, the slope
+/// masking table's azimuth and ν coordinates), specialized
 /// for every feature, and `extra` (the test's cases and entry function). The material's data is
 /// the harness's input buffer (`datum`).
 fn library(extra: &str) -> String {
@@ -22,6 +23,8 @@ fn library(extra: &str) -> String {
         include_str!("../src/shaders/microfacet/smith.wgsl"),
         include_str!("../src/shaders/microfacet/masking_shadowing.wgsl"),
         include_str!("../src/shaders/driver/footprint.wgsl"),
+        include_str!("../src/shaders/microfacet/slope_masking.wgsl"),
+        include_str!("../src/shaders/eval/slope_masking_table.wgsl"),
         include_str!("../src/shaders/eval/transfer_masking_table.wgsl"),
     ];
     let data = "var<private> params: Params;\nconst PI: f32 = 3.14159265;\nconst SQRT_2: f32 = 1.4142135;\nfn datum(i: u32) -> f32 { return inputs[i]; }\n";

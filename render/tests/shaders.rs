@@ -148,6 +148,8 @@ const MIRRORS: &[(&str, &str, &str, &str)] = &[
     ("eval/mixture_bins.wgsl", "shade_under", "eval/mixture_bins.rs", "filtered_bins"),
     ("eval/mixture_bins.wgsl", "conditioned_bin", "eval/mixture_bins.rs", "filtered_bins"),
     ("eval/mixture_bins.wgsl", "shading_add", "eval/shading.rs", "add"),
+    ("eval/slope_masking_table.wgsl", "azimuth_coordinate", "eval/slope_masking_table.rs", "azimuth_coordinate"),
+    ("eval/slope_masking_table.wgsl", "nu_coordinate", "eval/slope_masking_table.rs", "nu_coordinate"),
     ("eval/slope_masking_table.wgsl", "slope_masking_lookup", "eval/slope_masking_table.rs", "lookup"),
     ("eval/slope_weights.wgsl", "slope_weights_at", "eval/slope_weights.rs", "at"),
     ("eval/slope_weights.wgsl", "slope_weights_coordinate", "eval/slope_weights.rs", "coordinate"),

@@ -75,26 +75,14 @@ fn transfer_ray(base: u32, w: vec3<f32>, chol: vec3<f32>, sigma_h: f32) -> Trans
         ray.nu = max(w.z, 0.0) / r / (max(sigma_h, 1e-30) * st);
     }
     ray.projection = vec2<f32>(dir.x * chol.x + dir.y * chol.y, dir.y * chol.z) / st;
-    // The azimuth over [0, π) and ln ν, as slope_masking_table's azimuth_coordinate and
-    // nu_coordinate.
-    let pi = 3.14159265358979;
-    var phi = atan2(dir.y, dir.x);
-    if (phi < 0.0) {
-        phi = phi + pi;
-    }
-    if (phi >= pi) {
-        phi = phi - pi;
-    }
-    let xa = phi / pi * f32(TABLE_AZIMUTHS);
-    let a0 = min(u32(max(floor(xa), 0.0)), TABLE_AZIMUTHS - 1u);
-    let fa = clamp(xa - f32(a0), 0.0, 1.0);
+    // The azimuth over [0, π) and ln ν, as slope_masking_table's.
+    let ca = azimuth_coordinate(dir);
+    let a0 = u32(ca.x);
+    let fa = ca.y;
     let a1 = (a0 + 1u) % TABLE_AZIMUTHS;
-    var nv = 0.0;
-    if (ray.nu > 0.0) {
-        nv = clamp(log(ray.nu / TABLE_NU_MIN) / log(TABLE_NU_RATIO), 0.0, f32(TABLE_NUS - 1u));
-    }
-    let n0 = min(u32(nv), TABLE_NUS - 2u);
-    let fnu = nv - f32(n0);
+    let cn = nu_coordinate(ray.nu);
+    let n0 = u32(cn.x);
+    let fnu = cn.y;
     let e = base + 4u;
     ray.entries = vec4<u32>(
         e + (a0 * TABLE_NUS + n0) * TRANSFER_MOMENT_ENTRY,
