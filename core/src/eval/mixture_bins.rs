@@ -61,7 +61,7 @@ use std::f64::consts::FRAC_1_PI;
 /// the driver's slope ([`crate::eval::transfer_masking_table`]), at least: the bins' own 4 × 4.
 /// On #17's grid 6 × 6 gave terraces 2.66% / 1.19%, sponge 0.00% / 4.39% and moss 0 / 0, and 4 × 4
 /// gives 2.69% / 1.32%, 0.24% / 4.52% and 0.05% / 0.21%, at 1868 instead of 2260 ms a frame on
-/// llvmpipe (terraces, 256 × 192; Smith's bins 774).
+/// llvmpipe (terraces, 256 × 192; in one run with a Smith copy, 1872 against Smith's bins' 810).
 pub const CONDITIONED_SLOPE_POINTS: usize = 4;
 
 /// What a bin of the driver's value contributes: its mean g′, the root mean square of g′ and the
