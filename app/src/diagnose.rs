@@ -9,13 +9,13 @@
 //! truth.
 //!
 //! The truth is sampled in batches until its relative standard error is below `precision` and
-//! enough rays were cast for the sharpest glint to have shown (see `truth`), or `max_samples` is
+//! enough rays were cast for the sharpest glint to have shown (`Evaluator::converged_truth`), or `max_samples` is
 //! reached: glints make it noisy (the bumpy-specular preset needs ~10⁶ rays for 2%), and an
 //! error within three standard errors is not an error.
 
 use crate::preset_io::Resolved;
 use anyhow::Result;
-use lodestone_core::eval::{Estimate, FootprintQuery};
+use lodestone_core::eval::FootprintQuery;
 use lodestone_core::material::color_terms::ColorTerms;
 use lodestone_core::material::{ColorModel, Material};
 use lodestone_core::scene::direction::direction;
@@ -87,54 +87,6 @@ pub fn variants(m: &Material) -> Vec<(&'static str, Material)> {
     out
 }
 
-/// The ground truth of `cfg` in batches of 50 000 rays (seeds 1, 2, …) until its largest
-/// relative standard error is below `precision` and enough rays were cast for glints to show, or
-/// `max_samples` rays are spent.
-///
-/// Glints ([`Evaluator::glint_rays`]): a sharp specular lobe makes a ray's value heavy-tailed, and
-/// a batch that drew none has a small sample variance and a mean without the specular part
-/// (bumpy-specular at 75°, light 30° on the viewer's side: "0.34%" after 50 000 rays, the truth
-/// 15–18% low; 4·10⁶ rays put the model within 0.2%).
-///
-/// [`Evaluator::glint_rays`]: lodestone_core::eval::Evaluator::glint_rays
-fn truth(
-    p: &lodestone_core::eval::Evaluator,
-    cfg: &FootprintQuery,
-    precision: f64,
-    max_samples: usize,
-) -> Estimate {
-    let batch = 50_000.min(max_samples).max(2);
-    let (mut n, mut sum, mut sum2) = (0usize, [0.0f64; 3], [0.0f64; 3]);
-    let mut seed = 1;
-    loop {
-        let e = p.ground_truth(cfg, batch, seed);
-        seed += 1;
-        let m = e.samples as f64;
-        for k in 0..3 {
-            sum[k] += e.mean[k] * m;
-            // E[x²] from the batch's mean and standard error: se² = var/m, var ≈ E[x²] − mean².
-            sum2[k] += (e.std_error[k].powi(2) * m + e.mean[k].powi(2)) * m;
-        }
-        n += e.samples;
-        let nf = n as f64;
-        let mean = sum.map(|s| s / nf);
-        let std_error =
-            [0, 1, 2].map(|k| ((sum2[k] / nf - mean[k] * mean[k]).max(0.0) / nf).sqrt());
-        let rel = (0..3)
-            .filter(|&k| mean[k] > 0.0)
-            .map(|k| std_error[k] / mean[k])
-            .fold(0.0f64, f64::max);
-        let glints_seen = nf >= p.glint_rays(cfg, mean, precision);
-        if (rel <= precision && glints_seen) || n + batch > max_samples {
-            return Estimate {
-                mean,
-                std_error,
-                samples: n,
-            };
-        }
-    }
-}
-
 /// The configurations: every combination of view angle, light angle and light azimuth (degrees;
 /// the view's azimuth is 0).
 #[derive(Clone, Copy, Debug)]
@@ -181,7 +133,7 @@ pub fn diagnose(
                 let mut full = [0.0; 3];
                 for (name, p) in &prepared {
                     let cfg = FootprintQuery::far(p, wo, wi);
-                    let gt = truth(p, &cfg, precision, max_samples);
+                    let gt = p.converged_truth(&cfg, precision, max_samples);
                     let fi = p.filtered(&cfg);
                     if *name == "full" {
                         full = gt.mean;
@@ -248,7 +200,11 @@ pub fn table(material: &str, rows: &[Row]) -> String {
             pct(r.relative_error)
         };
         let of_full = r.error_of_full.map_or_else(|| "—".to_string(), pct);
-        let mixture = r.mixture_error.map_or_else(String::new, pct);
+        // Under the same rule as `itself`: relative to a truth near 0 it is noise.
+        let mixture = match r.mixture_error {
+            Some(_) if r.share < 0.01 => "—".to_string(),
+            m => m.map_or_else(String::new, pct),
+        };
         s += &format!(
             "{:<5} {:<13} {:<16} {:>5.0}% {:>21} {:>21} {:>7.2} {:>8}{:2} {:>21}\n",
             format!("{}°", r.view_deg),
