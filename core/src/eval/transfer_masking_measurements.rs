@@ -376,7 +376,8 @@ fn bins_against_the_value_mixture() {
 /// the image's centre. Found (docs/design.md, "The views at middle zoom"): every preset, the
 /// identity curve included, is darkest where the far weight is 0.07–0.3 (default at 80° with the
 /// light 60° along the view −9.0%, sponge −8.8%, against −1.6% and −3.5% far away), and the blend
-/// itself is not the cause (Smith's bins are as dark there).
+/// itself is not the cause (Smith's bins are as dark there). `LODESTONE_PRESETS=a,b` and
+/// `LODESTONE_CONFIGS="view,light,azimuth;…"` (degrees) choose what it runs.
 #[test]
 #[ignore = "a measurement, prints a table"]
 fn transfer_conditioned_middle_footprints() {
@@ -399,7 +400,17 @@ fn transfer_conditioned_middle_footprints() {
         let mut ms = m.clone();
         ms.filtering.slope_masking = SlopeMasking::Smith;
         let smith = Evaluator::new(&ms).expect("prepared");
-        for (view, light, az) in [(60.0, 0.0, 0.0), (60.0, 60.0, 180.0), (80.0, 60.0, 0.0)] {
+        let configs: Vec<(f64, f64, f64)> = match std::env::var("LODESTONE_CONFIGS") {
+            Ok(v) => v
+                .split(';')
+                .map(|c| {
+                    let x: Vec<f64> = c.split(',').map(|t| t.parse().expect("a number")).collect();
+                    (x[0], x[1], x[2])
+                })
+                .collect(),
+            Err(_) => vec![(60.0, 0.0, 0.0), (60.0, 60.0, 180.0), (80.0, 60.0, 0.0)],
+        };
+        for (view, light, az) in configs {
             let wi = direction(f64::to_radians(light), f64::to_radians(az));
             for distance in [3.5, 10.0, 35.0, 100.0, 350.0] {
                 let camera = Camera {
