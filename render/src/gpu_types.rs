@@ -147,8 +147,8 @@ gpu_struct! {
         correlation: u32 => "u32",
         /// D_h model (`HEIGHT_FILTER_*`).
         height_filter: u32 => "u32",
-        /// n of the n × n polar slope rule.
-        slope_points: u32 => "u32",
+        /// Nodes of the polar slope rule (`SlopeRule::len`: radii × angles).
+        slope_nodes: u32 => "u32",
         /// Mean of g(f), f ~ N(0, 1) (standardizes heights).
         g_mean: f32 => "f32",
         /// Std of g(f), f ~ N(0, 1).
@@ -275,8 +275,8 @@ gpu_struct! {
         transfer_monotone: u32 => "u32",
         /// Offset of the slope rule each bin of the transfer mixture uses.
         mix_rule_offset: u32 => "u32",
-        /// n of that n × n rule; 0 when the filtered view keeps one Gaussian (no mixture).
-        mix_points: u32 => "u32",
+        /// Nodes of that rule; 0 when the filtered view keeps one Gaussian (no mixture).
+        mix_nodes: u32 => "u32",
         /// 1 when the specular lobe uses the noise's own slope density (`NoiseSlopes::Exact`),
         /// 0 for the Gaussian.
         noise_slopes: u32 => "u32",
@@ -325,10 +325,10 @@ gpu_struct! {
         tm_offset: u32 => "u32",
         /// 1 when the transfer mixture's bins take that table (`tm_offset` is set).
         tm_on: u32 => "u32",
-        /// Offset of the slope rule the conditioned bins shade on (n × n nodes of x, y, weight).
+        /// Offset of the slope rule the conditioned bins shade on (x, y, weight per node).
         tm_rule_offset: u32 => "u32",
-        /// n of that rule (core's `CONDITIONED_SLOPE_POINTS`, or the bins' own n when larger).
-        tm_points: u32 => "u32",
+        /// Nodes of that rule (core's `conditioned_slope_rule`).
+        tm_nodes: u32 => "u32",
     }
 }
 

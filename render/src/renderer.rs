@@ -14,7 +14,7 @@ use lodestone_core::driver::field::{DriverField, TiledImage};
 use lodestone_core::driver::noise::SumOfSines;
 use lodestone_core::eval::Evaluator;
 use lodestone_core::eval::compiled::CompiledTransfer;
-use lodestone_core::eval::mixture_bins::CONDITIONED_SLOPE_POINTS;
+use lodestone_core::eval::mixture_bins::conditioned_slope_rule;
 use lodestone_core::material::color_terms::CombineMode;
 use lodestone_core::material::colormap::linear_to_srgb;
 use lodestone_core::material::features::{Feature, FeatureSet};
@@ -26,7 +26,7 @@ use lodestone_core::microfacet::effective_height::{EffectiveHeightTable, HeightF
 use lodestone_core::microfacet::height_mixture::bin_slope_points;
 use lodestone_core::microfacet::masking_shadowing::Correlation;
 use lodestone_core::microfacet::slope_density::NoiseSlopes;
-use lodestone_core::microfacet::visible_slopes::slope_rule;
+use lodestone_core::microfacet::slope_rule::SlopeRule;
 use lodestone_core::scene::bound_grid::BoundGrid;
 use lodestone_core::scene::camera::{Camera, PIXEL_SIGMA};
 use lodestone_core::scene::field_grid::{FIELD_MARGIN_F32, FieldGrid};
@@ -782,7 +782,7 @@ pub fn material_data_for(
         data.extend(&slopes.entries);
         mark(&data, start, "transfer table's slope pyramids");
     }
-    let points = m.filtering.slope_points.max(1) as usize;
+    let rule = m.slope_rule();
     if features.contains(Feature::Relief) {
         // Built on first use (process-wide): a session of flat materials never builds it.
         let dh = EffectiveHeightTable::shared();
@@ -796,7 +796,7 @@ pub fn material_data_for(
         }
         mark(&data, start, "visible-height table D_h");
         let start = data.len();
-        lay.slope_rule = push_rule(&mut data, points);
+        lay.slope_rule = push_rule(&mut data, rule);
         mark(&data, start, "slope quadrature rule");
         if let Some(t) = &prepared.slope_masking {
             let start = data.len();
@@ -808,9 +808,9 @@ pub fn material_data_for(
         }
         if m.transfer_mixture() {
             let n = bin_slope_points(m.filtering.slope_points, m.terms.slope.is_some());
-            base.mix_points = n as u32;
+            base.mix_nodes = n.len() as u32;
             base.mix_rule_offset = lay.slope_rule;
-            if n != points {
+            if n != rule {
                 let start = data.len();
                 base.mix_rule_offset = push_rule(&mut data, n);
                 mark(&data, start, "slope rule of the transfer mixture's bins");
@@ -827,8 +827,8 @@ pub fn material_data_for(
                     start,
                     "transfer curve's value- and slope-conditioned masking moments",
                 );
-                let tn = n.max(CONDITIONED_SLOPE_POINTS);
-                base.tm_points = tn as u32;
+                let tn = conditioned_slope_rule(n);
+                base.tm_nodes = tn.len() as u32;
                 base.tm_rule_offset = base.mix_rule_offset;
                 if tn != n {
                     let start = data.len();
@@ -925,7 +925,7 @@ pub fn material_data_for(
     base.tt_offset = lay.transfer_table;
     base.dh_offset = lay.dh;
     base.slope_rule_offset = lay.slope_rule;
-    base.slope_points = points as u32;
+    base.slope_nodes = rule.len() as u32;
     base.noise_slopes = u32::from(m.filtering.noise_slopes == NoiseSlopes::Exact);
     base.cp_offset = lay.color_poly;
     base.tp_offset = lay.transfer_poly;
@@ -971,10 +971,11 @@ pub fn material_data_for(
     }
 }
 
-/// Append the n × n slope rule ([`slope_rule`]: x, y, weight per node) and return its offset.
-fn push_rule(data: &mut Vec<f32>, n: usize) -> u32 {
+/// Append a slope rule's nodes ([`SlopeRule::nodes`]: x, y, weight per node) and return its
+/// offset.
+fn push_rule(data: &mut Vec<f32>, rule: SlopeRule) -> u32 {
     let offset = data.len() as u32;
-    for (z, w) in slope_rule(n) {
+    for (z, w) in rule.nodes() {
         data.extend([z.x as f32, z.y as f32, *w as f32]);
     }
     offset

@@ -89,7 +89,7 @@ impl Evaluator {
         let mean = loc.stats.slope_mean;
         let lit = sun_visible * vbar;
         let mut spec = self.specular_lobes(mean, &sigma, cfg.wo, cfg.wi);
-        let points = f.slope_points as usize;
+        let points = self.material.slope_rule();
         let (sun_color, env_color, shading) =
             match self.slope_weights(cfg.footprint, mean, &sigma, cfg.wo, [hm_sun, hm_env]) {
                 None => {

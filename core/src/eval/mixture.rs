@@ -80,7 +80,7 @@ impl Evaluator {
         let dz = 2.0 * Z_MAX / (NODES - 1) as f64;
         let zs: Vec<f64> = (0..NODES).map(|j| -Z_MAX + dz * j as f64).collect();
         let total: f64 = zs.iter().map(|&z| norm_pdf(z)).sum();
-        let points = m.filtering.slope_points as usize;
+        let points = m.slope_rule();
         let dphi = azimuth_difference(wo, wi);
         let sun_up = wi.z > 0.0;
         struct Node {

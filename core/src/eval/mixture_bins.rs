@@ -51,6 +51,7 @@ use crate::microfacet::height_mixture::{
     BIN_SAMPLES, bin_exponent, bin_masking, bin_slope_points, mixture_edges,
 };
 use crate::microfacet::masking_shadowing::G2;
+use crate::microfacet::slope_rule::SlopeRule;
 use crate::microfacet::slopes::SlopeCov;
 use crate::microfacet::visible_slopes::expected_positive_part;
 use glam::{DMat2, DMat3, DVec2, DVec3};
@@ -63,6 +64,16 @@ use std::f64::consts::FRAC_1_PI;
 /// gives 2.69% / 1.32%, 0.24% / 4.52% and 0.05% / 0.21%, at 1868 instead of 2260 ms a frame on
 /// llvmpipe (terraces, 256 × 192; in one run with a Smith copy, 1872 against Smith's bins' 810).
 pub const CONDITIONED_SLOPE_POINTS: usize = 4;
+
+/// The rule of the shading under each sub-value's tilted Gaussians: the bins' own rule, with at
+/// least [`CONDITIONED_SLOPE_POINTS`] radii.
+pub fn conditioned_slope_rule(bins: SlopeRule) -> SlopeRule {
+    if bins.radii >= CONDITIONED_SLOPE_POINTS {
+        bins
+    } else {
+        SlopeRule::square(CONDITIONED_SLOPE_POINTS)
+    }
+}
 
 /// What a bin of the driver's value contributes: its mean g′, the root mean square of g′ and the
 /// mean point colour.
@@ -177,7 +188,7 @@ impl Evaluator {
             .transfer_masking
             .as_ref()
             .map(|t| TransferRays::new(t, d, (wo, wi), sun_lit, sigma_h, m.filtering.correlation));
-        let conditioned_points = points.max(CONDITIONED_SLOPE_POINTS);
+        let conditioned_points = conditioned_slope_rule(points);
         let (mut above_o, mut above) = (0.0, 0.0);
         let (mut num, mut den) = ([0.0f64; 3], 0.0f64);
         for &(lo, hi, bin) in bins.iter().rev() {

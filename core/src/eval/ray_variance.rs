@@ -104,7 +104,7 @@ impl Evaluator {
         let mut m2 = [0.0; 3];
         // D's mean over lit points, for the specular cross term.
         let mut lit_d = [0.0; 3];
-        let points = f.slope_points as usize;
+        let points = self.material.slope_rule();
         let den = visible_slope_nodes(mean_slope, &sigma, cfg.wo, points, |n, wn| {
             for (color, wc) in &colors {
                 for (v, wv) in [(1.0, vbar), (0.0, 1.0 - vbar)] {

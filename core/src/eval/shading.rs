@@ -8,6 +8,7 @@ use crate::material::measured::ChannelWeights;
 use crate::material::merl_fit::fresnel_factor;
 use crate::math::gaussian::cholesky;
 use crate::microfacet::brdf::{BaseBrdf, filtered_specular, half_vector_posterior};
+use crate::microfacet::slope_rule::SlopeRule;
 use crate::microfacet::slopes::SlopeCov;
 use crate::microfacet::slopes::normal_of;
 use crate::microfacet::visible_slopes::visible_slope_nodes;
@@ -92,7 +93,7 @@ impl Evaluator {
         wi: DVec3,
         frame: &DMat3,
     ) -> SlopeShading {
-        let points = self.material.filtering.slope_points as usize;
+        let points = self.material.slope_rule();
         let (acc, den) = self.visible_shading_sums(mean, sigma, wo, wi, frame, points);
         if den > 0.0 {
             acc.scaled(1.0 / den)
@@ -110,7 +111,7 @@ impl Evaluator {
         wo: DVec3,
         wi: DVec3,
         frame: &DMat3,
-        points: usize,
+        points: SlopeRule,
     ) -> (SlopeShading, f64) {
         let mut acc = SlopeShading::default();
         let mut den = 0.0;

@@ -18,6 +18,7 @@ use crate::microfacet::effective_height::HeightMoments;
 use crate::microfacet::slope_masking::{
     JointMasking, SLOPE_NODES, SlopeMasking, height_rows, profile_at, slope_cell,
 };
+use crate::microfacet::slope_rule::SlopeRule;
 use crate::microfacet::slopes::{SlopeCov, slope_of};
 use crate::microfacet::visible_slopes::visible_slope_nodes;
 use glam::{DMat3, DVec2, DVec3};
@@ -256,7 +257,7 @@ impl Evaluator {
         wo: DVec3,
         wi: DVec3,
         frame: &DMat3,
-        points: usize,
+        points: SlopeRule,
         weights: &SlopeWeights,
     ) -> [(SlopeShading, f64); SLOPE_NODES] {
         let mut out = [(SlopeShading::default(), 0.0); SLOPE_NODES];
@@ -390,7 +391,7 @@ mod tests {
                 wo,
                 DVec3::Z,
                 &glam::DMat3::IDENTITY,
-                8,
+                SlopeRule::square(8),
                 &w,
             );
             let by_buckets: f64 = (0..SLOPE_NODES).map(|j| profile[j] * buckets[j].1).sum();

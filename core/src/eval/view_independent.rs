@@ -34,7 +34,7 @@ impl Evaluator {
             let cs = slope_mean(
                 loc.stats.slope_mean,
                 &loc.stats.slope_cov,
-                self.material.filtering.slope_points as usize,
+                self.material.slope_rule(),
                 |n| sc.sample(*frame * n),
             );
             sh.cs_cos = cs.map(|v| v * sh.cos);

@@ -40,6 +40,7 @@ use crate::microfacet::height_mixture::TransferSlopes;
 use crate::microfacet::masking_shadowing::Correlation;
 use crate::microfacet::slope_density::NoiseSlopes;
 use crate::microfacet::slope_masking::SlopeMasking;
+use crate::microfacet::slope_rule::SlopeRule;
 use crate::microfacet::slopes::SlopeCov;
 use serde::{Deserialize, Serialize};
 
@@ -415,6 +416,13 @@ impl Material {
             );
         }
         if p.0.is_empty() { Ok(()) } else { Err(p.0) }
+    }
+
+    /// The polar rule of the filtered views' averages over a footprint's slopes:
+    /// `filtering.slope_points` radii, twice as many angles with a slope colour term
+    /// ([`SlopeRule::for_material`]).
+    pub fn slope_rule(&self) -> SlopeRule {
+        SlopeRule::for_material(self.filtering.slope_points, self.terms.slope.is_some())
     }
 
     /// Slope covariance σ_nx², σ_ny² of the (pre-transfer) surface.

@@ -15,6 +15,7 @@
 //! `G_top·(u/hi)^Λ` inside it, so the bin's weight times its mean visibility is exact in closed
 //! form ([`bin_masking`]), and the bin below starts at `G_top·(lo/hi)^Λ`.
 
+use crate::microfacet::slope_rule::SlopeRule;
 use serde::{Deserialize, Serialize};
 
 /// How the filtered view models the slopes of a surface under a transfer curve.
@@ -48,15 +49,14 @@ pub const BIN_SAMPLES: usize = 4;
 /// on the presets.
 pub const MIXTURE_SLOPE_POINTS: usize = 4;
 
-/// n of the slope rule per bin: [`MIXTURE_SLOPE_POINTS`] (or the material's n when smaller), the
-/// material's own n when it has a slope colour term, whose C_s(n) can turn within a fraction of
+/// The slope rule per bin: n × n with n = [`MIXTURE_SLOPE_POINTS`] (or the material's n when
+/// smaller), the material's own rule ([`SlopeRule::for_material`]) when it has a slope colour term, whose C_s(n) can turn within a fraction of
 /// σ_n (snow: 8% off with 4 at the normal, measured).
-pub fn bin_slope_points(material_points: u32, slope_color: bool) -> usize {
-    let n = material_points.max(1) as usize;
+pub fn bin_slope_points(material_points: u32, slope_color: bool) -> SlopeRule {
     if slope_color {
-        n
+        SlopeRule::for_material(material_points, true)
     } else {
-        n.min(MIXTURE_SLOPE_POINTS)
+        SlopeRule::square((material_points.max(1) as usize).min(MIXTURE_SLOPE_POINTS))
     }
 }
 

@@ -24,6 +24,7 @@ pub mod height_mixture;
 pub mod masking_shadowing;
 pub mod slope_density;
 pub mod slope_masking;
+pub mod slope_rule;
 pub mod slopes;
 pub mod smith;
 pub mod visible_slopes;

@@ -64,6 +64,7 @@
 
 use crate::math::gaussian::cholesky;
 use crate::math::special::{erfcx, norm_cdf, norm_pdf};
+use crate::microfacet::slope_rule::SlopeRule;
 use crate::microfacet::slopes::SlopeCov;
 use crate::microfacet::slopes::normal_of;
 use glam::{DVec2, DVec3};
@@ -161,7 +162,8 @@ impl VisibleSlopes {
 }
 
 /// The quadrature rule over a standard bivariate normal used for every average over a footprint's
-/// slopes, with `n` radii × `n` angles (n² nodes, `filtering.slope_points` = n), cached per n:
+/// slopes, with `n` radii × `n` angles (n² nodes; a material with a slope colour doubles the
+/// angles, [`SlopeRule::for_material`]), cached per n:
 /// nodes `z` and weights summing to 1, so `E[q(s)] ≈ Σ w q(μ + L z)` for `s ~ N(μ, LLᵀ)`.
 ///
 /// Polar: the radius is Gauss–Legendre in the radial CDF `u = 1 − exp(−r²/2)` (`r = √(−2 ln(1 − u))`,
@@ -174,29 +176,7 @@ impl VisibleSlopes {
 /// −0.03%, +0.02%; for the clamped cosine both are within 0.1% from n = 6 (GH +0.03%, this +0.04% at
 /// n = 8). Tested in `slope_rule_tests`.
 pub fn slope_rule(n: usize) -> &'static [(DVec2, f64)] {
-    use std::sync::OnceLock;
-    static RULES: [OnceLock<Vec<(DVec2, f64)>>; 32] = [const { OnceLock::new() }; 32];
-    let n = n.clamp(1, 32);
-    RULES[n - 1].get_or_init(|| {
-        if n == 1 {
-            return vec![(DVec2::ZERO, 1.0)];
-        }
-        let (x, w) = crate::math::quadrature::gauss_legendre(n);
-        let mut nodes = Vec::with_capacity(n * n);
-        for (k, (xk, wk)) in x.iter().zip(&w).enumerate() {
-            let u = 0.5 * (xk + 1.0);
-            let r = (-2.0 * (-u).ln_1p()).sqrt();
-            let turn = 0.5 * (k % 2) as f64;
-            for j in 0..n {
-                let phi = std::f64::consts::TAU * (j as f64 + turn) / n as f64;
-                nodes.push((
-                    DVec2::new(r * phi.cos(), r * phi.sin()),
-                    0.5 * wk / n as f64,
-                ));
-            }
-        }
-        nodes
-    })
+    SlopeRule::square(n).nodes()
 }
 
 /// The nodes of the visible slope distribution D_s ∝ N(s; s̄, Σ)·u⁺(s), `u(s) = ωo_z − s·ωo_xy`
@@ -208,11 +188,11 @@ pub fn visible_slope_nodes(
     mean: DVec2,
     sigma: &SlopeCov,
     wo: DVec3,
-    n: usize,
+    rule: impl Into<SlopeRule>,
     mut visit: impl FnMut(DVec3, f64),
 ) -> f64 {
     let mut den = 0.0;
-    for (s, w) in slope_nodes(mean, sigma, n) {
+    for (s, w) in slope_nodes(mean, sigma, rule) {
         let wt = w * (wo.z - s.x * wo.x - s.y * wo.y).max(0.0);
         if wt > 0.0 {
             visit(normal_of(s), wt);
@@ -227,10 +207,11 @@ pub fn visible_slope_nodes(
 pub(crate) fn slope_nodes(
     mean: DVec2,
     sigma: &SlopeCov,
-    n: usize,
+    rule: impl Into<SlopeRule>,
 ) -> impl Iterator<Item = (DVec2, f64)> {
     let (l11, l21, l22) = cholesky(sigma.xx, sigma.xy, sigma.yy);
-    slope_rule(n)
+    rule.into()
+        .nodes()
         .iter()
         .map(move |(z, w)| (mean + DVec2::new(l11 * z.x, l21 * z.x + l22 * z.y), *w))
 }
@@ -240,11 +221,11 @@ pub(crate) fn slope_nodes(
 pub fn slope_mean(
     mean: DVec2,
     sigma: &SlopeCov,
-    n: usize,
+    rule: impl Into<SlopeRule>,
     q: impl Fn(DVec3) -> [f64; 3],
 ) -> [f64; 3] {
     let mut acc = [0.0; 3];
-    for (s, w) in slope_nodes(mean, sigma, n) {
+    for (s, w) in slope_nodes(mean, sigma, rule) {
         let v = q(normal_of(s));
         for c in 0..3 {
             acc[c] += w * v[c];

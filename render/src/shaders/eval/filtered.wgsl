@@ -15,9 +15,9 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
     let wo = above_horizon(vec3<f32>(dot(wo_w, t), dot(wo_w, b), dot(wo_w, nbar)));
     let wi = vec3<f32>(dot(wi_w, t), dot(wi_w, b), dot(wi_w, nbar));
 //#if transfer_mixture
-    // A transfer curve, or an image's value-conditioned slopes: the binned mixture (mix_points is 0
+    // A transfer curve, or an image's value-conditioned slopes: the binned mixture (mix_nodes is 0
     // otherwise).
-    if (params.mix_points > 0u) {
+    if (params.mix_nodes > 0u) {
         return filtered_bins(loc, wo_w, wi_w, wo, wi, sun_visible);
     }
 //#endif
@@ -60,7 +60,7 @@ fn eval_filtered(x0: vec2<f32>, fp: vec3<f32>, wo_w: vec3<f32>, wi_w: vec3<f32>,
 //#if environment
         env_h = slope_heights(hmo);
 //#endif
-        visible_shading_buckets(s_mean, cov, wo_w, wi_w, params.slope_rule_offset, params.slope_points, weights);
+        visible_shading_buckets(s_mean, cov, wo_w, wi_w, params.slope_rule_offset, params.slope_nodes, weights);
         let joint = joint_inputs(sun_h, env_h, d, ms.total, hm, ms.lambda_o, hmo);
         sun_color = joint.sun;
         env_color = joint.env;

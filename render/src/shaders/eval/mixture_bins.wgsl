@@ -111,7 +111,7 @@ fn filtered_bins(loc: FootprintStats, wo_w: vec3<f32>, wi_w: vec3<f32>, wo: vec3
         // Smith's bin, weighted by its share (all of it without the conditioned masking).
         if (far < 1.0) {
             let share = 1.0 - far;
-            let sums = visible_shading_sums(s_mean, cov, wo_w, wi_w, params.mix_rule_offset, params.mix_points);
+            let sums = visible_shading_sums(s_mean, cov, wo_w, wi_w, params.mix_rule_offset, params.mix_nodes);
             den = den + share * w1 * sums.den;
             var v = 0.0;
             var spec = vec3<f32>(0.0);
@@ -168,7 +168,7 @@ fn shade_under(w: GaussianWeight, mean: vec2<f32>, lz: mat2x2<f32>, wo_w: vec3<f
     }
     let c = lz * symmetric_matrix(t.cov) * transpose(lz);
     out.mass = t.mass;
-    out.sums = visible_shading_sums(mean + lz * t.mean, vec3<f32>(c[0][0], c[1][1], 0.5 * (c[0][1] + c[1][0])), wo_w, wi_w, params.tm_rule_offset, params.tm_points);
+    out.sums = visible_shading_sums(mean + lz * t.mean, vec3<f32>(c[0][0], c[1][1], 0.5 * (c[0][1] + c[1][0])), wo_w, wi_w, params.tm_rule_offset, params.tm_nodes);
     return out;
 }
 

@@ -195,7 +195,7 @@ fn has_environment() -> bool {
 // Evaluator::visible_shading: point_shading averaged on the nodes of D_s (visible_slope_nodes),
 // world slope space, slopes N(mean, cov).
 fn visible_shading(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> SlopeShading {
-    let sums = visible_shading_sums(mean, cov, wo, wi, params.slope_rule_offset, params.slope_points);
+    let sums = visible_shading_sums(mean, cov, wo, wi, params.slope_rule_offset, params.slope_nodes);
     var acc = sums.s;
     if (sums.den > 0.0) {
         let inv = 1.0 / sums.den;
@@ -213,10 +213,9 @@ struct ShadingSums {
     den: f32,
 }
 
-// Evaluator::visible_shading_sums, on the n × n rule stored at `rule_off`.
-fn visible_shading_sums(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, rule_off: u32, points: u32) -> ShadingSums {
+// Evaluator::visible_shading_sums, on the rule of `nodes` nodes stored at `rule_off`.
+fn visible_shading_sums(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, rule_off: u32, nodes: u32) -> ShadingSums {
     let l = cholesky(cov);
-    let nodes = points * points;
     var acc: SlopeShading;
     acc.cos = 0.0;
     acc.cs_cos = vec3<f32>(0.0);

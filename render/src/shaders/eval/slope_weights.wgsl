@@ -79,9 +79,8 @@ fn bucket(j: u32) -> SlopeShading {
 
 // Evaluator::visible_shading_buckets: each visible node to the two slope nodes around its slope
 // along the view, with linear (hat) weights (into the bucket arrays).
-fn visible_shading_buckets(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, rule_off: u32, points: u32, weights: SlopeWeights) {
+fn visible_shading_buckets(mean: vec2<f32>, cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>, rule_off: u32, nodes: u32, weights: SlopeWeights) {
     let l = cholesky(cov);
-    let nodes = points * points;
     for (var j = 0u; j < SLOPE_NODES; j = j + 1u) {
         bucket_cos[j] = 0.0;
         bucket_cs_cos[j] = vec3<f32>(0.0);

@@ -6,7 +6,7 @@
 // visible_slopes::slope_mean of C_s: the footprint average without visibility weight.
 fn slope_color_mean(mean: vec2<f32>, cov: vec3<f32>) -> vec3<f32> {
     let l = cholesky(cov);
-    let nodes = params.slope_points * params.slope_points;
+    let nodes = params.slope_nodes;
     var acc = vec3<f32>(0.0);
     for (var i = 0u; i < nodes; i = i + 1u) {
         let z = slope_node(i);
