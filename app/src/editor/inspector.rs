@@ -862,7 +862,7 @@ fn filtering(ui: &mut Ui, f: &mut Filtering) -> bool {
     }
     changed |= ui
         .add(Slider::new(&mut f.slope_points, 1..=Filtering::MAX_SLOPE_POINTS).text("Slope points"))
-        .on_hover_text("n: radii × angles of the polar rule for averages over the visible slope distribution D_s (diffuse cosine, slope colour C_s, environment; n² nodes per pixel) [HNPN14 Sec. 5.2]")
+        .on_hover_text("n: the radii of the polar rule for averages over the visible slope distribution D_s (diffuse cosine, slope colour C_s, environment), with n angles per ring, 2n with a slope colour (it turns with the facet's azimuth); n² or 2n² nodes per pixel [HNPN14 Sec. 5.2]")
         .changed();
     changed
 }
