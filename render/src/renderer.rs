@@ -807,7 +807,7 @@ pub fn material_data_for(
             mark(&data, start, "slope-conditioned masking table");
         }
         if m.transfer_mixture() {
-            let n = bin_slope_points(m.filtering.slope_points, m.terms.slope.is_some());
+            let n = bin_slope_points(rule, m.terms.slope.is_some());
             base.mix_nodes = n.len() as u32;
             base.mix_rule_offset = lay.slope_rule;
             if n != rule {

@@ -183,7 +183,7 @@ impl Evaluator {
         let kd = b.albedo * FRAC_1_PI;
         let weights = self.channel_weights();
         let sun = m.lighting.sun * sun_visible;
-        let points = bin_slope_points(m.filtering.slope_points, m.terms.slope.is_some());
+        let points = bin_slope_points(m.slope_rule(), m.terms.slope.is_some());
         let conditioned = self
             .transfer_masking
             .as_ref()

@@ -419,10 +419,15 @@ impl Material {
     }
 
     /// The polar rule of the filtered views' averages over a footprint's slopes:
-    /// `filtering.slope_points` radii, twice as many angles with a slope colour term
-    /// ([`SlopeRule::for_material`]).
+    /// `filtering.slope_points` radii, twice as many angles with a slope colour term whose map
+    /// changes colour ([`SlopeRule::for_material`]; a constant C_s has nothing to resolve, and
+    /// keeps the rule, so it equals the constant term exactly).
     pub fn slope_rule(&self) -> SlopeRule {
-        SlopeRule::for_material(self.filtering.slope_points, self.terms.slope.is_some())
+        let turns = self.terms.slope.as_ref().is_some_and(|t| {
+            let stops = &t.color.map.stops;
+            stops.iter().any(|s| s.color != stops[0].color)
+        });
+        SlopeRule::for_material(self.filtering.slope_points, turns)
     }
 
     /// Slope covariance σ_nx², σ_ny² of the (pre-transfer) surface.
@@ -449,6 +454,34 @@ impl Material {
 mod tests {
     use super::*;
     use crate::material::colormap::{ColorStop, Interpolation};
+
+    /// A slope colour that changes colour doubles the rule's angles; one colour does not (it
+    /// must equal the constant term exactly), and neither does a material without one.
+    #[test]
+    fn the_slope_rule_follows_the_slope_colour() {
+        let text = |name: &str| {
+            std::fs::read_to_string(format!(
+                "{}/../presets/{name}.ron",
+                env!("CARGO_MANIFEST_DIR")
+            ))
+            .unwrap()
+        };
+        let snake = Material::from_ron(&text("snake-skin")).unwrap();
+        assert_eq!(
+            snake.slope_rule(),
+            SlopeRule {
+                radii: 8,
+                angles: 16
+            }
+        );
+        let mut one = snake.clone();
+        let t = one.terms.slope.as_mut().unwrap();
+        let c = t.color.map.stops[0].color;
+        t.color.map.stops.iter_mut().for_each(|s| s.color = c);
+        assert_eq!(one.slope_rule(), SlopeRule::square(8));
+        let default = Material::from_ron(&text("default")).unwrap();
+        assert_eq!(default.slope_rule(), SlopeRule::square(8));
+    }
 
     #[test]
     fn round_trips_through_ron() {

@@ -50,13 +50,13 @@ pub const BIN_SAMPLES: usize = 4;
 pub const MIXTURE_SLOPE_POINTS: usize = 4;
 
 /// The slope rule per bin: n × n with n = [`MIXTURE_SLOPE_POINTS`] (or the material's n when
-/// smaller), the material's own rule ([`SlopeRule::for_material`]) when it has a slope colour term, whose C_s(n) can turn within a fraction of
-/// σ_n (snow: 8% off with 4 at the normal, measured).
-pub fn bin_slope_points(material_points: u32, slope_color: bool) -> SlopeRule {
+/// smaller), the material's own rule (`Material::slope_rule`) when it has a slope colour term,
+/// whose C_s(n) can turn within a fraction of σ_n (snow: 8% off with 4 at the normal, measured).
+pub fn bin_slope_points(material: SlopeRule, slope_color: bool) -> SlopeRule {
     if slope_color {
-        SlopeRule::for_material(material_points, true)
+        material
     } else {
-        SlopeRule::square((material_points.max(1) as usize).min(MIXTURE_SLOPE_POINTS))
+        SlopeRule::square(material.radii.min(MIXTURE_SLOPE_POINTS))
     }
 }
 
