@@ -1,0 +1,147 @@
+//! #17 at middle zoom: the views' pixels ([`Evaluator::plane_pixel`]: the level-of-detail march,
+//! the filtered model at the pixel's footprint, a shadow ray on h̄) against the explicit surface
+//! traced through random points of the same pixels, image means over a 48 × 36 image of 10°
+//! field of view (its views within ±5° of the named one), diffuse only (the glints of a truth at
+//! a few rays a pixel would bury it). The far-patch grid (`accuracy.rs`) cannot see this zoom:
+//! where a footprint resolves part of the relief, the march masks the resolved part and the model
+//! the rest (docs/design.md, "The views at middle zoom").
+//!
+//! As in `accuracy.rs`, the error that counts is beyond 3 standard errors of the truth, worst
+//! channel, against #17's goal (1% up to 60°, 4% beyond); [`KNOWN`] holds the measured shortfalls
+//! (×1.1), so the test fails when a configuration that met the goal stops meeting it or a known
+//! shortfall grows. Shrink or remove an entry when a change improves it.
+
+use glam::{DVec2, DVec3};
+use lodestone_core::eval::{Evaluator, Method};
+use lodestone_core::material::Material;
+use lodestone_core::scene::camera::Camera;
+use lodestone_core::scene::direction::direction;
+use lodestone_tests::{prepare, presets};
+
+const W: u32 = 48;
+const H: u32 = 36;
+/// Truth rays per pixel.
+const RAYS: usize = 32;
+
+/// (preset file, view, light angle, light azimuth, distance): distances 10, 35 and 350 put the
+/// far weight `(σ_f,footprint/σ_f)²` at the image's centre near 0.07, 0.45 and 1 on these presets.
+const CONFIGS: &[(&str, f64, f64, f64, f64)] = &[
+    ("default.ron", 60.0, 0.0, 0.0, 10.0),
+    ("default.ron", 60.0, 0.0, 0.0, 35.0),
+    ("default.ron", 60.0, 60.0, 180.0, 10.0),
+    ("default.ron", 60.0, 60.0, 180.0, 35.0),
+    ("default.ron", 80.0, 60.0, 0.0, 10.0),
+    ("default.ron", 80.0, 60.0, 0.0, 35.0),
+    ("default.ron", 80.0, 60.0, 0.0, 350.0),
+    ("sponge.ron", 60.0, 0.0, 0.0, 10.0),
+    ("sponge.ron", 60.0, 60.0, 180.0, 10.0),
+    ("sponge.ron", 60.0, 60.0, 180.0, 350.0),
+];
+
+/// Open shortfalls: (preset, view, light, azimuth, distance, largest excess allowed), measured
+/// 2026-12-05 (×1.1). All at distance 10 (far weight about 0.07), the bottom of the dip; the
+/// same configurations at 35 and 350 meet the goal.
+const KNOWN: &[(&str, f64, f64, f64, f64, f64)] = &[
+    // −2.93%: the light opposite.
+    ("default.ron", 60.0, 60.0, 180.0, 10.0, 0.0215),
+    // −8.05% (far patch −1.5%).
+    ("default.ron", 80.0, 60.0, 0.0, 10.0, 0.0765),
+    // −4.60% with the light at the normal: the masking alone.
+    ("sponge.ron", 60.0, 0.0, 0.0, 10.0, 0.0423),
+    // −8.69%.
+    ("sponge.ron", 60.0, 60.0, 180.0, 10.0, 0.0845),
+];
+
+/// The image mean of the filtered view and of the truth, and the truth's standard error.
+fn image_means(p: &Evaluator, camera: &Camera, wi: DVec3) -> ([f64; 3], [f64; 3], [f64; 3]) {
+    let clear = p.surface.clear_camera(camera);
+    let (mut f, mut t, mut t2) = ([0.0f64; 3], [0.0f64; 3], [0.0f64; 3]);
+    let mut rng = 5u64;
+    let mut uniform = || {
+        rng = rng.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = rng;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for y in 0..H {
+        for x in 0..W {
+            let c = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
+            let v = p.plane_pixel(Method::Filtered, camera, c, (W, H), wi);
+            for k in 0..3 {
+                f[k] += v[k];
+            }
+            for _ in 0..RAYS {
+                let j = DVec2::new(uniform(), uniform());
+                let r = clear.ray(DVec2::new(f64::from(x), f64::from(y)) + j, W, H);
+                let v = p.trace_ray(r.origin, r.dir, wi);
+                for k in 0..3 {
+                    t[k] += v[k];
+                    t2[k] += v[k] * v[k];
+                }
+            }
+        }
+    }
+    let (np, nt) = (f64::from(W * H), (W * H) as f64 * RAYS as f64);
+    let tm = t.map(|s| s / nt);
+    let se = [0, 1, 2].map(|k| ((t2[k] / nt - tm[k] * tm[k]).max(0.0) / nt).sqrt());
+    (f.map(|s| s / np), tm, se)
+}
+
+#[test]
+fn middle_zoom_meets_the_accuracy_goal_or_its_known_bound() {
+    let all = presets();
+    let mut failures = vec![];
+    for &(name, view, light, azimuth, distance) in CONFIGS {
+        let (path, text) = all
+            .iter()
+            .find(|(p, _)| p.ends_with(name))
+            .unwrap_or_else(|| panic!("{name} is in presets/"));
+        let mut m = Material::from_ron(text).unwrap();
+        m.brdf.specular = 0.0;
+        let p = prepare(path, &m);
+        let camera = Camera {
+            elevation_deg: view,
+            azimuth_deg: 0.0,
+            distance,
+            target: [3.0, -7.0],
+            fov_deg: 10.0,
+        };
+        let wi = direction(light.to_radians(), azimuth.to_radians());
+        let (f, t, se) = image_means(&p, &camera, wi);
+        let peak = t.iter().copied().fold(0.0f64, f64::max);
+        let (mut excess, mut signed) = (0.0f64, 0.0f64);
+        for k in 0..3 {
+            if t[k] <= 1e-3 * peak {
+                continue;
+            }
+            let e = ((f[k] - t[k]).abs() - 3.0 * se[k]).max(0.0) / t[k];
+            if e >= excess {
+                excess = e;
+                signed = (f[k] - t[k]) / t[k];
+            }
+        }
+        let goal = if view <= 60.0 { 0.01 } else { 0.04 };
+        let known = KNOWN
+            .iter()
+            .find(|k| {
+                k.0 == name && k.1 == view && k.2 == light && k.3 == azimuth && k.4 == distance
+            })
+            .map(|k| k.5);
+        let bound = known.unwrap_or(goal);
+        eprintln!(
+            "{name:<12} view {view:>2}° light {light:>2}°/{azimuth:>3}° distance {distance:>5}: {:+.2}%, beyond 3 s.e. {:.2}% (bound {:.2}%)",
+            100.0 * signed,
+            100.0 * excess,
+            100.0 * bound
+        );
+        if excess > bound {
+            failures.push(format!(
+                "{name} view {view} light {light}/{azimuth} distance {distance}: {:.2}% beyond the truth's noise, bound {:.2}%",
+                100.0 * excess,
+                100.0 * bound
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join(",\n"));
+}
