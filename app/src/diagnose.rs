@@ -269,4 +269,40 @@ mod tests {
         }
         assert!((d.share + s.share - 1.0).abs() < 1e-9);
     }
+
+    /// A variant whose truth is near 0 (the specular with the lobe out of reach) prints a dash for
+    /// its relative errors, the prototype's included, instead of a ratio to noise (it printed
+    /// 10¹³⁴%); a variant with a share prints both.
+    #[test]
+    fn relative_errors_of_a_vanishing_truth_print_a_dash() {
+        let row = |share: f64| Row {
+            variant: "specular only".into(),
+            view_deg: 75.0,
+            light_deg: 60.0,
+            light_azimuth_deg: 0.0,
+            filtered: [1e-3; 3],
+            truth: [1e-300; 3],
+            std_error: [0.0; 3],
+            error_of_full: Some([0.0; 3]),
+            relative_error: [1e297; 3],
+            share,
+            samples: 10,
+            mixture_error: Some([2e297; 3]),
+            significant: true,
+        };
+        let t = table("m", &[row(0.0)]);
+        let last = t.lines().last().unwrap();
+        assert!(!last.contains("e29") && !last.contains("000000"), "{last}");
+        assert_eq!(last.matches('—').count(), 2, "{last}");
+        let shown = table(
+            "m",
+            &[Row {
+                relative_error: [0.01; 3],
+                mixture_error: Some([0.02; 3]),
+                ..row(0.5)
+            }],
+        );
+        let last = shown.lines().last().unwrap();
+        assert!(last.contains("+1.00") && last.contains("+2.00"), "{last}");
+    }
 }
