@@ -809,12 +809,13 @@ pub fn material_data_for(
         if m.transfer_mixture() {
             let n = bin_slope_points(rule, m.terms.slope.is_some());
             base.mix_nodes = n.len() as u32;
-            base.mix_rule_offset = lay.slope_rule;
-            if n != rule {
-                let start = data.len();
-                base.mix_rule_offset = push_rule(&mut data, n);
-                mark(&data, start, "slope rule of the transfer mixture's bins");
-            }
+            base.mix_rule_offset = shared_or_pushed(
+                &mut data,
+                n,
+                (rule, lay.slope_rule),
+                &mut mark,
+                "slope rule of the transfer mixture's bins",
+            );
             if let Some(t) = &prepared.transfer_masking {
                 let start = data.len();
                 base.tm_offset = data.len() as u32;
@@ -829,12 +830,13 @@ pub fn material_data_for(
                 );
                 let tn = conditioned_slope_rule(n);
                 base.tm_nodes = tn.len() as u32;
-                base.tm_rule_offset = base.mix_rule_offset;
-                if tn != n {
-                    let start = data.len();
-                    base.tm_rule_offset = push_rule(&mut data, tn);
-                    mark(&data, start, "slope rule of the conditioned bins");
-                }
+                base.tm_rule_offset = shared_or_pushed(
+                    &mut data,
+                    tn,
+                    (n, base.mix_rule_offset),
+                    &mut mark,
+                    "slope rule of the conditioned bins",
+                );
             }
         }
     }
@@ -969,6 +971,24 @@ pub fn material_data_for(
         params: base,
         segments,
     }
+}
+
+/// The offset of `rule`: the already uploaded `shared` rule's when it is the same rule, else
+/// `rule` appended ([`push_rule`]) and marked as `name`.
+fn shared_or_pushed(
+    data: &mut Vec<f32>,
+    rule: SlopeRule,
+    (shared, offset): (SlopeRule, u32),
+    mark: &mut impl FnMut(&Vec<f32>, usize, &'static str),
+    name: &'static str,
+) -> u32 {
+    if rule == shared {
+        return offset;
+    }
+    let start = data.len();
+    let at = push_rule(data, rule);
+    mark(data, start, name);
+    at
 }
 
 /// Append a slope rule's nodes ([`SlopeRule::nodes`]: x, y, weight per node) and return its
