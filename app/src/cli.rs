@@ -153,6 +153,10 @@ pub enum Command {
         /// Skip the reference march (its /ref columns print NaN): a quicker A/B of the fast march.
         #[arg(long)]
         no_reference: bool,
+        /// Whether the analytic views' camera rays can stop on a crest's unresolved relief
+        /// (`off` is the reference: rays meet h̄).
+        #[arg(long, value_enum, default_value_t = InterceptionArg::Crests)]
+        interception: InterceptionArg,
         /// Print JSON.
         #[arg(long)]
         json: bool,
@@ -380,6 +384,26 @@ impl MarchArg {
         match self {
             Self::Reference => lodestone_core::scene::march::March::Reference,
             Self::Fast => lodestone_core::scene::march::March::Fast,
+        }
+    }
+}
+
+/// Whether the analytic views' camera rays can stop on the unresolved relief of a crest they pass
+/// (`lodestone_core::eval::interception::Interception`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum InterceptionArg {
+    /// Rays meet h̄ only (the reference, before #17's middle-zoom work).
+    Off,
+    /// Rays can stop on crests (the views' default).
+    Crests,
+}
+
+impl InterceptionArg {
+    /// The core value.
+    pub fn interception(self) -> lodestone_core::eval::interception::Interception {
+        match self {
+            Self::Off => lodestone_core::eval::interception::Interception::Off,
+            Self::Crests => lodestone_core::eval::interception::Interception::Crests,
         }
     }
 }

@@ -260,6 +260,7 @@ fn run(cli: Cli) -> Result<()> {
             presets,
             modes,
             no_reference,
+            interception,
         }) => {
             let mut sweep = vec![];
             if presets.is_empty() {
@@ -280,6 +281,7 @@ fn run(cli: Cli) -> Result<()> {
                 frames,
                 modes: modes.iter().map(|m| m.name()).collect(),
                 reference: !no_reference,
+                interception: interception.interception(),
             };
             render_cmd::bench(&sweep, &cfg, json)?
         }

@@ -315,6 +315,8 @@ pub struct BenchSweep {
     pub modes: Vec<&'static str>,
     /// Whether to time the reference march too (else its columns print NaN).
     pub reference: bool,
+    /// Whether the analytic views' rays can stop on crests.
+    pub interception: lodestone_core::eval::interception::Interception,
 }
 
 /// The modes a bench row times, with their JSON names.
@@ -360,7 +362,8 @@ pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Re
     let mut target = ViewTarget::new(&r, w, h)?;
     let mut rows = vec![];
     for (name, preset) in presets {
-        let prepared = preset.prepare()?;
+        let mut prepared = preset.prepare()?;
+        prepared.interception = cfg.interception;
         let mut reference = prepared.clone();
         reference.surface.march = March::Reference;
         let mut flat_material = preset.clone();

@@ -8,7 +8,9 @@ use crate::gpu_types::{GpuStruct, MaterialParams};
 use lodestone_core::driver::conditional_slopes;
 use lodestone_core::driver::histogram::G_END;
 use lodestone_core::eval::lod_surface::LOD_SETTLE;
-use lodestone_core::eval::{slope_masking_table, transfer_masking_table, transfer_moments};
+use lodestone_core::eval::{
+    interception, slope_masking_table, transfer_masking_table, transfer_moments,
+};
 use lodestone_core::math::gaussian_weight;
 use lodestone_core::microfacet::effective_height::{
     FIT_ALPHA_MU, FIT_ALPHA_SIGMA, FIT_BETA_MU, FIT_BETA_SIGMA,
@@ -189,6 +191,7 @@ pub fn wgsl_prelude() -> &'static str {
                 transfer_masking_table::MOMENT_ENTRY as u32,
             ),
             ("DATA_ROW", crate::renderer::DATA_ROW),
+            ("INTERCEPTION_MAX_STEPS", interception::MAX_STEPS as u32),
         ];
         for (name, v) in sets.into_iter().flatten().chain(counts) {
             let _ = writeln!(s, "const {name}: u32 = {v}u;");
@@ -205,6 +208,9 @@ pub fn wgsl_prelude() -> &'static str {
             ("GRID_MARGIN", GRID_MARGIN_F32),
             ("FIELD_SETTLE", FIELD_SETTLE),
             ("LOD_SETTLE", LOD_SETTLE),
+            ("INTERCEPTION_LEVEL_STEP", interception::LEVEL_STEP),
+            ("INTERCEPTION_REACH", interception::REACH),
+            ("INTERCEPTION_MIN_WEIGHT", interception::MIN_WEIGHT),
             ("HISTOGRAM_G_END", G_END),
             ("TABLE_NU_MIN", slope_masking_table::NU_MIN),
             ("TABLE_NU_RATIO", slope_masking_table::NU_RATIO),

@@ -329,6 +329,15 @@ gpu_struct! {
         tm_rule_offset: u32 => "u32",
         /// Nodes of that rule (core's `conditioned_slope_rule`).
         tm_nodes: u32 => "u32",
+        /// 1 when camera rays can be stopped by the unresolved relief on a crest they pass (core's
+        /// `eval::interception::Interception::Crests`), 0 when they meet h̄.
+        interception: u32 => "u32",
+        /// Padding: the struct rounds up to 16 bytes in WGSL.
+        pad0: u32 => "u32",
+        /// Padding.
+        pad1: u32 => "u32",
+        /// Padding.
+        pad2: u32 => "u32",
     }
 }
 

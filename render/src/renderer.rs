@@ -14,6 +14,7 @@ use lodestone_core::driver::field::{DriverField, TiledImage};
 use lodestone_core::driver::noise::SumOfSines;
 use lodestone_core::eval::Evaluator;
 use lodestone_core::eval::compiled::CompiledTransfer;
+use lodestone_core::eval::interception::Interception;
 use lodestone_core::eval::mixture_bins::conditioned_slope_rule;
 use lodestone_core::material::color_terms::CombineMode;
 use lodestone_core::material::colormap::linear_to_srgb;
@@ -929,6 +930,7 @@ pub fn material_data_for(
     base.slope_rule_offset = lay.slope_rule;
     base.slope_nodes = rule.len() as u32;
     base.noise_slopes = u32::from(m.filtering.noise_slopes == NoiseSlopes::Exact);
+    base.interception = u32::from(prepared.interception == Interception::Crests);
     base.cp_offset = lay.color_poly;
     base.tp_offset = lay.transfer_poly;
     base.sigma_h = s.sigma_h as f32;

@@ -72,6 +72,7 @@ pub const MATERIAL_FILES: &[(&str, &str)] = wgsl_files![
     "eval/mixture_bins.wgsl",
     "eval/ground_truth.wgsl",
     "eval/lod_surface.wgsl",
+    "eval/interception.wgsl",
     "eval/pixel.wgsl",
 ];
 

@@ -8,6 +8,7 @@ use crate::driver::field::DriverField;
 use crate::driver::histogram::DriverHistogram;
 use crate::driver::image::ImageDriver;
 use crate::eval::compiled::{CompiledColor, CompiledTransfer};
+use crate::eval::interception::Interception;
 use crate::eval::slope_masking_table::SlopeMaskingTable;
 use crate::eval::transfer_masking_table::TransferMaskingTable;
 use crate::material::Material;
@@ -53,6 +54,9 @@ pub struct Evaluator {
     /// ([`crate::eval::transfer_masking_table`]): built for a noise driver under a transfer curve
     /// when `filtering.slope_masking` is conditioned (Smith's bins otherwise).
     pub transfer_masking: Option<Arc<TransferMaskingTable>>,
+    /// Whether the analytic views' camera rays can be stopped by the unresolved relief on a crest
+    /// they pass before meeting h̄ ([`crate::eval::interception`]).
+    pub interception: Interception,
 }
 
 impl Evaluator {
@@ -169,6 +173,7 @@ impl Evaluator {
             measured: None,
             slope_masking,
             transfer_masking,
+            interception: Interception::default(),
         })
     }
 

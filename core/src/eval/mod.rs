@@ -36,6 +36,7 @@ pub mod evaluator;
 pub mod filtered;
 pub mod ground_truth;
 pub mod image_bandwidth;
+pub mod interception;
 pub mod lod_surface;
 pub mod mixture;
 pub mod mixture_bins;
