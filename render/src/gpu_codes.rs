@@ -211,6 +211,7 @@ pub fn wgsl_prelude() -> &'static str {
             ("INTERCEPTION_LEVEL_STEP", interception::LEVEL_STEP),
             ("INTERCEPTION_REACH", interception::REACH),
             ("INTERCEPTION_MIN_WEIGHT", interception::MIN_WEIGHT),
+            ("INTERCEPTION_SLOPE_REACH", interception::SLOPE_REACH),
             ("HISTOGRAM_G_END", G_END),
             ("TABLE_NU_MIN", slope_masking_table::NU_MIN),
             ("TABLE_NU_RATIO", slope_masking_table::NU_RATIO),

@@ -332,12 +332,13 @@ gpu_struct! {
         /// 1 when camera rays can be stopped by the unresolved relief on a crest they pass (core's
         /// `eval::interception::Interception::Crests`), 0 when they meet h̄.
         interception: u32 => "u32",
-        /// Padding: the struct rounds up to 16 bytes in WGSL.
-        pad0: u32 => "u32",
-        /// Padding.
-        pad1: u32 => "u32",
-        /// Padding.
-        pad2: u32 => "u32",
+        /// The driver's unfiltered gradient covariance, xx (core's `DriverField::gradient_cov`,
+        /// world units): with the footprint's unresolved part it bounds the resolved slope.
+        grad_cov_xx: f32 => "f32",
+        /// Its yy.
+        grad_cov_yy: f32 => "f32",
+        /// Its xy.
+        grad_cov_xy: f32 => "f32",
     }
 }
 

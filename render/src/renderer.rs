@@ -931,6 +931,9 @@ pub fn material_data_for(
     base.slope_nodes = rule.len() as u32;
     base.noise_slopes = u32::from(m.filtering.noise_slopes == NoiseSlopes::Exact);
     base.interception = u32::from(prepared.interception == Interception::Crests);
+    let g = prepared.surface.driver.gradient_cov();
+    (base.grad_cov_xx, base.grad_cov_yy, base.grad_cov_xy) =
+        (g.xx as f32, g.yy as f32, g.xy as f32);
     base.cp_offset = lay.color_poly;
     base.tp_offset = lay.transfer_poly;
     base.sigma_h = s.sigma_h as f32;

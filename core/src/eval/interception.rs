@@ -32,6 +32,7 @@
 use crate::driver::footprint::Footprint;
 use crate::eval::{Evaluator, FootprintQuery};
 use crate::math::special::{norm_cdf, norm_pdf};
+use crate::microfacet::slopes::SlopeCov;
 use glam::{DVec2, DVec3};
 
 /// Whether the analytic views let the unresolved relief stop camera rays before h̄.
@@ -61,6 +62,9 @@ pub const REACH: f64 = 3.5;
 /// than 0.2% of the difference between the two footprints, and the second evaluation (the
 /// costliest part of such a pixel) is skipped.
 pub const MIN_WEIGHT: f64 = 2e-3;
+/// Deviations of h̄'s slope along the ray beyond which the ray is taken never to rise above a
+/// falling h̄ (one-sided normal tail 3.2e-5).
+pub const SLOPE_REACH: f64 = 4.0;
 /// Most fine steps along one ray.
 pub const MAX_STEPS: usize = 2048;
 
@@ -86,7 +90,8 @@ impl Evaluator {
             x0: DVec2::new(hit.x, hit.y),
             footprint: fp,
         };
-        let stats = self.footprint_stats(&cfg).stats;
+        let loc = self.footprint_stats(&cfg);
+        let stats = loc.stats;
         let c = stats.slope_cov;
         let sq = (dh.x * dh.x * c.xx + 2.0 * dh.x * dh.y * c.xy + dh.y * dh.y * c.yy)
             .max(0.0)
@@ -101,14 +106,19 @@ impl Evaluator {
             let p = o + d * t;
             p.z - self.lod_height(DVec2::new(p.x, p.y), fp)
         };
-        // Skip where the relief cannot reach the ray: a gap beyond REACH·σ_u closes no faster
-        // than the march's rate.
+        // The relief cannot reach the ray where the gap is beyond REACH·σ_u.
         let reach = REACH * su;
-        let rate = self.lod_rate(d, fp).max(1e-12);
-        // u rises only where h̄ falls away along the ray faster than the ray descends: never when
-        // the bound of h̄'s slope along the ray, (rate − |d_z|)/r, is below the descent |d_z|/r.
-        // Then every step is the final approach (steep views: no stepping at all).
-        if rate - d.z.abs() <= d.z.abs() {
+        // u rises only where h̄ falls away along the ray faster than the ray descends (|d_z|/r):
+        // not when that is beyond SLOPE_REACH deviations of h̄'s slope along the ray, at most
+        // σ_h·max|g′| times the resolved driver gradient's (unfiltered less unresolved). Then
+        // every step would be the final approach: no stepping at all (steep or distant views).
+        let s = &self.surface;
+        let (total, unresolved) = (s.driver.gradient_cov(), loc.driver.gradient_cov);
+        let along =
+            |c: SlopeCov| dh.x * dh.x * c.xx + 2.0 * dh.x * dh.y * c.xy + dh.y * dh.y * c.yy;
+        let resolved =
+            s.sigma_h.abs() * s.g_lip * (along(total) - along(unresolved)).max(0.0).sqrt();
+        if d.z.abs() / r > SLOPE_REACH * resolved {
             return None;
         }
         let (ds_min, ds_max) = (0.1 * width, width);
@@ -128,7 +138,13 @@ impl Evaluator {
             }
             let u = level(t);
             if u > reach {
-                t += ((u - reach) / rate).max(ds_min / r);
+                // Far above h̄: the level-of-detail march on h̄ + reach finds where the ray comes
+                // within reach again (it does before the hit, where u = 0).
+                let q = o + d * t - DVec3::Z * reach;
+                let Some(dt) = self.lod_march(q, d, fp) else {
+                    break;
+                };
+                t += dt.max(ds_min / r);
                 prev = None;
                 continue;
             }

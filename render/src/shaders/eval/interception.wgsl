@@ -16,7 +16,8 @@ fn interception(o: vec3<f32>, d: vec3<f32>, t_hit: f32, fp: vec3<f32>, sf: f32) 
     }
     let dh = d.xy / r;
     let hit = o + d * t_hit;
-    let stats = footprint_stats(hit.xy, fp).stats;
+    let loc = footprint_stats(hit.xy, fp);
+    let stats = loc.stats;
     let c = stats.slope_cov; // xx, yy, xy
     let sq = sqrt(max(dh.x * dh.x * c.x + 2.0 * dh.x * dh.y * c.z + dh.y * dh.y * c.y, 0.0));
     let su = stats.height_std;
@@ -24,11 +25,16 @@ fn interception(o: vec3<f32>, d: vec3<f32>, t_hit: f32, fp: vec3<f32>, sf: f32) 
     if (!(su > 1e-12) || !(sq > 0.0) || !(width > 0.0)) {
         return vec2<f32>(0.0);
     }
-    let reach = INTERCEPTION_REACH * su;
-    let rate = max(lod_rate(d), 1e-12);
-    if (rate - abs(d.z) <= abs(d.z)) {
+    // h̄'s slope along the ray: σ_h·max|g′| times the resolved driver gradient's deviation
+    // (unfiltered less unresolved); a descent beyond SLOPE_REACH of them never rises.
+    let gu = loc.driver.gradient_cov;
+    let along_total = dh.x * dh.x * params.grad_cov_xx + 2.0 * dh.x * dh.y * params.grad_cov_xy + dh.y * dh.y * params.grad_cov_yy;
+    let along_unresolved = dh.x * dh.x * gu.x + 2.0 * dh.x * dh.y * gu.z + dh.y * dh.y * gu.y;
+    let resolved = abs(params.sigma_h) * params.g_lip * sqrt(max(along_total - along_unresolved, 0.0));
+    if (abs(d.z) / r > INTERCEPTION_SLOPE_REACH * resolved) {
         return vec2<f32>(0.0);
     }
+    let reach = INTERCEPTION_REACH * su;
     let ds_min = 0.1 * width;
     let ds_max = width;
     var t = 0.0;
@@ -49,7 +55,11 @@ fn interception(o: vec3<f32>, d: vec3<f32>, t_hit: f32, fp: vec3<f32>, sf: f32) 
         let p = o + d * t;
         let u = p.z - lod_height(p.xy, sf);
         if (u > reach) {
-            t = t + max((u - reach) / rate, ds_min / r);
+            let dt = lod_march(p - vec3<f32>(0.0, 0.0, reach), d, sf);
+            if (dt < 0.0) {
+                break;
+            }
+            t = t + max(dt, ds_min / r);
             have_prev = false;
             continue;
         }
