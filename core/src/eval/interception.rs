@@ -108,6 +108,7 @@ impl Evaluator {
         };
         // The relief cannot reach the ray where the gap is beyond REACH·σ_u.
         let reach = REACH * su;
+        let rate = self.lod_rate(d, fp).max(1e-12);
         // u rises only where h̄ falls away along the ray faster than the ray descends (|d_z|/r):
         // not when that is beyond SLOPE_REACH deviations of h̄'s slope along the ray, at most
         // σ_h·max|g′| times the resolved driver gradient's (unfiltered less unresolved). Then
@@ -138,13 +139,10 @@ impl Evaluator {
             }
             let u = level(t);
             if u > reach {
-                // Far above h̄: the level-of-detail march on h̄ + reach finds where the ray comes
-                // within reach again (it does before the hit, where u = 0).
-                let q = o + d * t - DVec3::Z * reach;
-                let Some(dt) = self.lod_march(q, d, fp) else {
-                    break;
-                };
-                t += dt.max(ds_min / r);
+                // A gap beyond the reach closes no faster than the march's rate bound. (The march
+                // on h̄ + reach is quicker, 416 against 471 ms, but under the reference march the
+                // GPU's f32 bisection then moves the steps on sponge: 72 pixels off core.)
+                t += ((u - reach) / rate).max(ds_min / r);
                 prev = None;
                 continue;
             }

@@ -35,6 +35,7 @@ fn interception(o: vec3<f32>, d: vec3<f32>, t_hit: f32, fp: vec3<f32>, sf: f32) 
         return vec2<f32>(0.0);
     }
     let reach = INTERCEPTION_REACH * su;
+    let rate = max(lod_rate(d), 1e-12);
     let ds_min = 0.1 * width;
     let ds_max = width;
     var t = 0.0;
@@ -55,11 +56,7 @@ fn interception(o: vec3<f32>, d: vec3<f32>, t_hit: f32, fp: vec3<f32>, sf: f32) 
         let p = o + d * t;
         let u = p.z - lod_height(p.xy, sf);
         if (u > reach) {
-            let dt = lod_march(p - vec3<f32>(0.0, 0.0, reach), d, sf);
-            if (dt < 0.0) {
-                break;
-            }
-            t = t + max(dt, ds_min / r);
+            t = t + max((u - reach) / rate, ds_min / r);
             have_prev = false;
             continue;
         }
