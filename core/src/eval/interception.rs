@@ -92,10 +92,10 @@ impl Evaluator {
         };
         let loc = self.footprint_stats(&cfg);
         let stats = loc.stats;
-        let c = stats.slope_cov;
-        let sq = (dh.x * dh.x * c.xx + 2.0 * dh.x * dh.y * c.xy + dh.y * dh.y * c.yy)
-            .max(0.0)
-            .sqrt();
+        // A covariance's variance along the ray's horizontal direction.
+        let along =
+            |c: SlopeCov| dh.x * dh.x * c.xx + 2.0 * dh.x * dh.y * c.xy + dh.y * dh.y * c.yy;
+        let sq = along(stats.slope_cov).max(0.0).sqrt();
         let su = stats.height_std;
         let width = fp.min_std();
         if !(su > 1e-12) || !(sq > 0.0) || !(width > 0.0) {
@@ -115,8 +115,6 @@ impl Evaluator {
         // every step would be the final approach: no stepping at all (steep or distant views).
         let s = &self.surface;
         let (total, unresolved) = (s.driver.gradient_cov(), loc.driver.gradient_cov);
-        let along =
-            |c: SlopeCov| dh.x * dh.x * c.xx + 2.0 * dh.x * dh.y * c.xy + dh.y * dh.y * c.yy;
         let resolved =
             s.sigma_h.abs() * s.g_lip * (along(total) - along(unresolved)).max(0.0).sqrt();
         if d.z.abs() / r > SLOPE_REACH * resolved {
