@@ -62,16 +62,10 @@ impl Evaluator {
         fp: Footprint,
         frame: &DMat3,
     ) -> [f64; 3] {
-        let sun_visible = wi.z > 0.0 && self.lod_march(p, wi, fp).is_none();
+        let (cfg, sun_visible) = self.footprint_at(p, dir, wi, fp);
         if !sun_visible && self.environment.is_none() {
             return [0.0; 3];
         }
-        let cfg = FootprintQuery {
-            wo: -dir,
-            wi,
-            x0: DVec2::new(p.x, p.y),
-            footprint: fp,
-        };
         let v = if sun_visible { 1.0 } else { 0.0 };
         match method {
             Method::Naive => self.naive_lit(&cfg, v, frame),
@@ -103,7 +97,18 @@ impl Evaluator {
         fp: Footprint,
     ) -> Option<(FootprintQuery, bool)> {
         let (o, t) = self.pixel_hit(origin, dir, fp)?;
-        let p = o + dir * t;
+        Some(self.footprint_at(o + dir * t, dir, wi, fp))
+    }
+
+    /// The query of the footprint `fp` around point `p` of h̄ seen along `dir`, and whether a shadow
+    /// ray on h̄ from `p` reaches the light.
+    fn footprint_at(
+        &self,
+        p: DVec3,
+        dir: DVec3,
+        wi: DVec3,
+        fp: Footprint,
+    ) -> (FootprintQuery, bool) {
         let sun_visible = wi.z > 0.0 && self.lod_march(p, wi, fp).is_none();
         let cfg = FootprintQuery {
             wo: -dir,
@@ -111,7 +116,7 @@ impl Evaluator {
             x0: DVec2::new(p.x, p.y),
             footprint: fp,
         };
-        Some((cfg, sun_visible))
+        (cfg, sun_visible)
     }
 
     /// One pixel of an analytic view of the plane: pixel centre `p` of a `width × height` image of
