@@ -191,6 +191,13 @@ const GPU_ONLY: &[(&str, &str, &str)] = &[
     ("bindings.wgsl", "datum", "reads entry i of the material's data (the snippet's storage buffer)"),
     ("data_texture.wgsl", "datum", "reads entry i of the material's data (the views' texture)"),
     ("bindings.wgsl", "note_cut", "records a loop the adapter cut (Mesa's loop limiter)"),
+    ("bindings.wgsl", "budget_step", "note_budget's state, one step on (a linear congruential step)"),
+    ("bindings.wgsl", "note_budget", "records whether the invocation's loop budget ran out (Mesa's loop limiter)"),
+    ("view.wgsl", "budget_two", "2, as a value the shader compiler cannot fold (note_budget)"),
+    ("eval/shading.wgsl", "sh9_coefficient", "reads coefficient i of the environment's Sh9 from the data buffer"),
+    ("eval/transfer_masking_table.wgsl", "add_corner", "one corner of moments_at (its loop body, four per iteration)"),
+    ("math/special.wgsl", "erf_series_term", "one term of erf_series_sum (its loop body, eight per iteration)"),
+    ("math/special.wgsl", "cf_step", "one level of cf_tail (its loop body, eight per iteration)"),
     ("bindings.wgsl", "note_work", "adds to a truth ray's work (its cost, for cost-aware adaptive plans)"),
 ];
 
@@ -443,7 +450,7 @@ fn loops_the_adapter_cuts_are_noticed() {
     let bindings = include_str!("../src/shaders/bindings.wgsl");
     let detector: String = bindings
         .split("\n\n")
-        .filter(|b| b.contains("loop_cut"))
+        .filter(|b| b.contains("loop_cut") || b.contains("fn budget_step"))
         .collect::<Vec<_>>()
         .join("\n\n");
     assert!(detector.contains("fn note_cut"), "{detector}");
@@ -464,4 +471,64 @@ fn loops_the_adapter_cuts_are_noticed() {
         );
     }
     assert_eq!(out[0], 1000.0);
+}
+
+/// The adapter's loop budget belongs to the whole invocation, not to one loop (bindings.wgsl
+/// `loop_cut`): a loop far below the limit is cut once earlier loops have spent it, and
+/// `note_budget` notices that although no loop reports it. Flagged exactly when a loop fell
+/// short; on a software adapter a first loop of 65 500 iterations leaves too little for a second
+/// of about 100, and one of 65 400 does not.
+#[test]
+fn a_spent_loop_budget_is_noticed() {
+    let Some(ctx) = lodestone_tests::gpu("the loop-budget test") else {
+        return;
+    };
+    let bindings = include_str!("../src/shaders/bindings.wgsl");
+    let detector: String = bindings
+        .split("\n\n")
+        .filter(|b| b.contains("loop_cut") || b.contains("fn budget_step"))
+        .collect::<Vec<_>>()
+        .join("\n\n");
+    assert!(detector.contains("fn note_budget"), "{detector}");
+    // Neither loop calls note_cut. Their counts have no bound the compiler can see (or it would
+    // unroll them) and their results no closed form (or it would drop the loop). Returns 1 when
+    // both loops ran their course, plus 2 when the budget was flagged.
+    let lcg_n = |n: u32| {
+        (0..n).fold(0u32, |s, _| {
+            s.wrapping_mul(1664525).wrapping_add(1013904223)
+        })
+    };
+    let cases = [
+        (vec![10u32, 30000, 65400], false),
+        (vec![65500, 70000], true),
+    ];
+    // lcg_n's values for the inputs and the second loop's lengths, computed here.
+    let mut expected = vec!["fn lcg_of(n: u32) -> u32 {".to_string()];
+    for &n in cases.iter().flat_map(|(v, _)| v) {
+        for k in [n, 100 + n % 7] {
+            expected.push(format!("    if (n == {k}u) {{ return {}u; }}", lcg_n(k)));
+        }
+    }
+    expected.push("    return 0u;\n}".into());
+    let lib = format!(
+        "{detector}\nfn lcg(s: u32) -> u32 {{ return s * 1664525u + 1013904223u; }}\n\
+         fn lcg_n(n: u32) -> u32 {{ var s = 0u; for (var i = 0u; i < n; i = i + 1u) {{ s = lcg(s); }} return s; }}\n\
+         fn run(x: f32) -> f32 {{ let n = u32(x); let c = lcg_n(n); \
+         let m = 100u + n % 7u + (n >> 31u) * 65535u; let d = lcg_n(m); \
+         note_budget(2u + (n >> 31u) * 65535u); \
+         return select(0.0, 1.0, c == lcg_of(n) && d == lcg_of(m)) + select(0.0, 2.0, loop_cut); }}\n{}",
+        expected.join("\n")
+    );
+    // Separate dispatches: the eight lanes of a SIMD batch share one budget.
+    for (inputs, spent) in cases {
+        let inputs: Vec<f32> = inputs.iter().map(|&n| n as f32).collect();
+        let out = lodestone_render::compute::eval_unary(&ctx, &lib, "run", &inputs);
+        for (x, y) in inputs.iter().zip(&out) {
+            let (ran, flagged) = (y % 2.0 == 1.0, *y >= 2.0);
+            assert_eq!(flagged, !ran, "{x}: {y}");
+            if ctx.is_software() {
+                assert_eq!(flagged, spent, "{x}: {y} on {}", ctx.describe());
+            }
+        }
+    }
 }

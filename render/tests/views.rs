@@ -466,13 +466,7 @@ fn fast_and_reference_marches_render_the_same_images() {
         ("sponge.ron", Shape::Plane),
         ("default.ron", Shape::Cylinder { radius: 1.5 }),
     ] {
-        let mut fast = Evaluator::new(&preset(name)).unwrap();
-        if name == "sponge.ron" {
-            // Open (#17): with rays stopped on crests the GPU's reference march puts 29 of the
-            // sponge's filtered pixels 5–15% off core's (core's two marches agree exactly, and the
-            // GPU's fast march agrees with core); not the crest's shadow ray. Compared without.
-            fast.interception = lodestone_core::eval::interception::Interception::Off;
-        }
+        let fast = Evaluator::new(&preset(name)).unwrap();
         let mut reference = fast.clone();
         reference.surface.march = March::Reference;
         assert_eq!(fast.surface.march, March::Fast, "the default march");

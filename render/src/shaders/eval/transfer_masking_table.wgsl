@@ -141,16 +141,27 @@ fn moments_at(ray: TransferRay, x: f32, len: f32) -> vec3<f32> {
     let ck = length_cell(len);
     let i = u32(ci.x);
     let k = u32(ck.x);
+    // The four blocks' corners one iteration per (value, length) corner, in core's order (every
+    // iteration counts against the software adapter's per-invocation loop budget, bindings.wgsl).
     var m = vec3<f32>(0.0);
-    for (var c = 0u; c < 16u; c = c + 1u) {
-        let corner = c & 3u;
-        let di = (c >> 2u) & 1u;
-        let dk = (c >> 3u) & 1u;
-        let w = ray.weights[corner] * select(1.0 - ci.y, ci.y, di == 1u) * select(1.0 - ck.y, ck.y, dk == 1u);
-        if (w != 0.0) {
-            let o = ray.entries[corner] + ((i + di) * TRANSFER_LENGTH_NODES + k + dk) * 3u;
-            m = m + w * vec3<f32>(datum(o), datum(o + 1u), datum(o + 2u));
-        }
+    for (var c = 0u; c < 16u; c = c + 4u) {
+        m = add_corner(m, ray, c, ci.y, ck.y, i, k);
+        m = add_corner(m, ray, c + 1u, ci.y, ck.y, i, k);
+        m = add_corner(m, ray, c + 2u, ci.y, ck.y, i, k);
+        m = add_corner(m, ray, c + 3u, ci.y, ck.y, i, k);
+    }
+    return m;
+}
+
+// moments_at's corner c (block c & 3, value step bit 2, length step bit 3) added to m.
+fn add_corner(m: vec3<f32>, ray: TransferRay, c: u32, fi: f32, fk: f32, i: u32, k: u32) -> vec3<f32> {
+    let corner = c & 3u;
+    let di = (c >> 2u) & 1u;
+    let dk = (c >> 3u) & 1u;
+    let w = ray.weights[corner] * select(1.0 - fi, fi, di == 1u) * select(1.0 - fk, fk, dk == 1u);
+    if (w != 0.0) {
+        let o = ray.entries[corner] + ((i + di) * TRANSFER_LENGTH_NODES + k + dk) * 3u;
+        return m + w * vec3<f32>(datum(o), datum(o + 1u), datum(o + 2u));
     }
     return m;
 }

@@ -12,11 +12,17 @@ fn poly_eval(off: u32, k: u32, channels: u32, ch: u32, x: f32) -> f32 {
     if (x >= datum(off + k - 1u)) {
         return datum(tails + channels + ch);
     }
-    // Last knot ≤ x.
+    // Last knot ≤ x (core's partition_point): bisection on the ascending knots, knot[seg] ≤ x <
+    // knot[end] throughout. A scan over the knots cost k iterations per call, and every loop
+    // iteration counts against the software adapter's per-invocation budget (bindings.wgsl).
     var seg = 0u;
-    for (var i = 1u; i < k - 1u; i = i + 1u) {
-        if (datum(off + i) <= x) {
-            seg = i;
+    var end = k - 1u;
+    while (end - seg > 1u) {
+        let mid = (seg + end) / 2u;
+        if (datum(off + mid) <= x) {
+            seg = mid;
+        } else {
+            end = mid;
         }
     }
     let a = datum(off + seg);

@@ -13,21 +13,55 @@ const CF_THRESHOLD: f32 = 1.0;
 const CF_DEPTH: u32 = 48u;
 const SERIES_TERMS: u32 = 24u;
 
+// The series and the continued fraction take eight terms per loop iteration (the same terms in
+// the same order): every iteration counts against the software adapter's per-invocation loop
+// budget (bindings.wgsl), and these run in every Λ and Φ.
+const_assert SERIES_TERMS % 8u == 0u && CF_DEPTH % 8u == 0u;
+
+fn erf_series_term(term: f32, x2: f32, n: u32) -> f32 {
+    return term * (2.0 * x2 / (2.0 * f32(n) + 1.0));
+}
+
 fn erf_series_sum(x: f32) -> f32 {
     let x2 = x * x;
     var term = x;
     var sum = x;
-    for (var n = 1u; n <= SERIES_TERMS; n = n + 1u) {
-        term = term * (2.0 * x2 / (2.0 * f32(n) + 1.0));
+    for (var n = 1u; n <= SERIES_TERMS; n = n + 8u) {
+        term = erf_series_term(term, x2, n);
+        sum = sum + term;
+        term = erf_series_term(term, x2, n + 1u);
+        sum = sum + term;
+        term = erf_series_term(term, x2, n + 2u);
+        sum = sum + term;
+        term = erf_series_term(term, x2, n + 3u);
+        sum = sum + term;
+        term = erf_series_term(term, x2, n + 4u);
+        sum = sum + term;
+        term = erf_series_term(term, x2, n + 5u);
+        sum = sum + term;
+        term = erf_series_term(term, x2, n + 6u);
+        sum = sum + term;
+        term = erf_series_term(term, x2, n + 7u);
         sum = sum + term;
     }
     return sum;
 }
 
+fn cf_step(t: f32, x: f32, n: u32) -> f32 {
+    return x + (f32(n) + 1.0) * 0.5 / t;
+}
+
 fn cf_tail(x: f32) -> f32 {
     var t = x;
-    for (var n = CF_DEPTH; n >= 1u; n = n - 1u) {
-        t = x + (f32(n) + 1.0) * 0.5 / t;
+    for (var n = CF_DEPTH; n >= 8u; n = n - 8u) {
+        t = cf_step(t, x, n);
+        t = cf_step(t, x, n - 1u);
+        t = cf_step(t, x, n - 2u);
+        t = cf_step(t, x, n - 3u);
+        t = cf_step(t, x, n - 4u);
+        t = cf_step(t, x, n - 5u);
+        t = cf_step(t, x, n - 6u);
+        t = cf_step(t, x, n - 7u);
     }
     return t;
 }
