@@ -1323,6 +1323,21 @@ impl Renderer {
         target.read(self)
     }
 
+    /// [`Renderer::render`], with the count of pixels (analytic modes) or rays (ground truth)
+    /// whose loops the adapter cut ([`ViewTarget::cut_count`]), for a caller that shows it.
+    pub fn render_counted(
+        &self,
+        material: &GpuMaterial,
+        scene: &Scene,
+        mode: ViewMode,
+        (width, height): (u32, u32),
+        samples: u32,
+    ) -> Result<(LinearImage, u32), RenderError> {
+        let mut target = ViewTarget::new(self, width, height)?;
+        self.draw(&mut target, material, scene, mode, samples);
+        Ok((target.read(self)?, target.cut_count(self)?))
+    }
+
     /// Draw into a persistent target. Analytic modes overwrite it; ground truth adds `samples` more
     /// rays per pixel to what the target holds (progressive; low-discrepancy, so any count is
     /// unbiased). Call [`ViewTarget::reset`] when the camera, light or material changes.

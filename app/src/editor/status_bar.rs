@@ -48,16 +48,25 @@ impl EditorApp {
                     ui.weak(t);
                     // Adapter-dependent (llvmpipe only): left out of snapshots like the times.
                     if f.cut_rays > 0 && !self.deterministic {
+                        let (what, hint) = if m == ViewMode::Truth {
+                            (
+                                "truth rays",
+                                "`lodestone render --retry-cut-rays` traces them again alone.",
+                            )
+                        } else {
+                            ("pixels", "A real GPU has no such limit.")
+                        };
                         ui.colored_label(
                             ui.visuals().warn_fg_color,
-                            format!("{} truth rays cut", f.cut_rays),
+                            format!("{} {what} cut", f.cut_rays),
                         )
-                        .on_hover_text(
-                            "These ground-truth rays skim the relief near the horizon for so many \
-                             steps that the software adapter (Mesa's llvmpipe) stopped their loops \
-                             after 65535 iterations: their pixels may be wrong. \
-                             `lodestone render --retry-cut-rays` traces them again alone.",
-                        );
+                        .on_hover_text(format!(
+                            "The software adapter (Mesa's llvmpipe) gives each shader invocation \
+                             65535 loop iterations in all (shared by the 8 pixels or rays of its \
+                             SIMD batch) and then stops every loop silently; these {what} ran out \
+                             (long marches skimming the relief near the horizon, mostly), so they \
+                             may be wrong. {hint}"
+                        ));
                     }
                 }
             }

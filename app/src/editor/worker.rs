@@ -81,8 +81,8 @@ pub struct Frame {
     pub moments: Option<Arc<SampleMoments>>,
     /// GPU time of the pass that produced it (for truth: of the last ray per pixel).
     pub pass_time: Duration,
-    /// Ground-truth rays in it whose loops the adapter cut (`ViewTarget::cut_count`: Mesa's
-    /// loop limit on llvmpipe); 0 for analytic modes.
+    /// Ground-truth rays, or an analytic mode's pixels, in it whose loops the adapter cut
+    /// (`ViewTarget::cut_count`: Mesa's loop budget on llvmpipe).
     pub cut_rays: u32,
     /// Resolution as a fraction of the full view size.
     pub scale: f32,
@@ -434,10 +434,10 @@ impl State {
                     return Ok(None);
                 };
                 let t0 = Instant::now();
-                let img = self.renderer.render(gm, &req.scene, mode, size, 1);
+                let img = self.renderer.render_counted(gm, &req.scene, mode, size, 1);
                 let dt = t0.elapsed();
                 match img {
-                    Ok(image) => {
+                    Ok((image, cut)) => {
                         self.set_cost(mode, dt.as_secs_f64() / f64::from(size.0 * size.1));
                         send(Event::Frame(Frame {
                             generation: req.generation,
@@ -450,7 +450,7 @@ impl State {
                             cost: None,
                             moments: None,
                             pass_time: dt,
-                            cut_rays: 0,
+                            cut_rays: cut,
                             scale,
                         }));
                     }
