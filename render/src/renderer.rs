@@ -441,21 +441,7 @@ impl ViewTarget {
     /// Log a warning when [`cut_count`](Self::cut_count) is above 0 (what `mode` drew here).
     pub fn warn_if_cut(&self, renderer: &Renderer, mode: ViewMode) {
         match self.cut_count(renderer) {
-            Ok(0) => {}
-            Ok(n) => {
-                let what = if mode == ViewMode::Truth {
-                    format!("{n} ground-truth rays")
-                } else {
-                    format!("{n} pixels of {mode:?}")
-                };
-                log::warn!(
-                    "{what} ({}×{}) ran into the adapter's loop limit and may be wrong \
-                     (Mesa's software rasterizer stops any shader loop after 65535 iterations; \
-                     `--retry-cut-rays` traces such rays again alone, slowly)",
-                    self.width,
-                    self.height
-                );
-            }
+            Ok(n) => warn_cut(n, mode, (self.width, self.height)),
             Err(e) => log::warn!("could not read the cut-loop count: {e}"),
         }
     }
@@ -1317,10 +1303,9 @@ impl Renderer {
         (width, height): (u32, u32),
         samples: u32,
     ) -> Result<LinearImage, RenderError> {
-        let mut target = ViewTarget::new(self, width, height)?;
-        self.draw(&mut target, material, scene, mode, samples);
-        target.warn_if_cut(self, mode);
-        target.read(self)
+        let (image, cut) = self.render_counted(material, scene, mode, (width, height), samples)?;
+        warn_cut(cut, mode, (width, height));
+        Ok(image)
     }
 
     /// [`Renderer::render`], with the count of pixels (analytic modes) or rays (ground truth)
@@ -1647,4 +1632,22 @@ impl Renderer {
     pub fn wait(&self) {
         let _ = self.ctx.device.poll(wgpu::PollType::wait_indefinitely());
     }
+}
+
+/// Log a warning when `n` pixels (analytic modes) or rays (ground truth) of a `size` view of
+/// `mode` had loops the adapter cut ([`ViewTarget::cut_count`]).
+fn warn_cut(n: u32, mode: ViewMode, (width, height): (u32, u32)) {
+    if n == 0 {
+        return;
+    }
+    let what = if mode == ViewMode::Truth {
+        format!("{n} ground-truth rays")
+    } else {
+        format!("{n} pixels of {mode:?}")
+    };
+    log::warn!(
+        "{what} ({width}×{height}) ran out of the adapter's loop budget and may be wrong \
+         (Mesa's software rasterizer gives a shader invocation 65535 loop iterations in all; \
+         `--retry-cut-rays` traces such rays again alone, slowly)"
+    );
 }

@@ -438,6 +438,15 @@ fn wgsl_norm_quantile_matches_core_on_the_adapter() {
     );
 }
 
+/// bindings.wgsl's blocks that say whether a loop was cut (`loop_cut`, `note_cut`, `note_budget`).
+fn loop_detector() -> String {
+    include_str!("../src/shaders/bindings.wgsl")
+        .split("\n\n")
+        .filter(|b| b.contains("loop_cut") || b.contains("fn budget_step"))
+        .collect::<Vec<_>>()
+        .join("\n\n")
+}
+
 /// The cut-loop detector (`bindings.wgsl` `note_cut`) on the adapter: a loop that ends short of
 /// its own condition is noticed, and one that runs to its end is not. On Mesa's software
 /// adapters a loop is cut after 65535 iterations; on other adapters nothing is cut and the flag
@@ -447,12 +456,7 @@ fn loops_the_adapter_cuts_are_noticed() {
     let Some(ctx) = lodestone_tests::gpu("the cut-loop test") else {
         return;
     };
-    let bindings = include_str!("../src/shaders/bindings.wgsl");
-    let detector: String = bindings
-        .split("\n\n")
-        .filter(|b| b.contains("loop_cut") || b.contains("fn budget_step"))
-        .collect::<Vec<_>>()
-        .join("\n\n");
+    let detector = loop_detector();
     assert!(detector.contains("fn note_cut"), "{detector}");
     let lib = format!(
         "{detector}\nfn run(x: f32) -> f32 {{ let n = u32(x); var c = 0u; var i = 0u; \
@@ -483,12 +487,7 @@ fn a_spent_loop_budget_is_noticed() {
     let Some(ctx) = lodestone_tests::gpu("the loop-budget test") else {
         return;
     };
-    let bindings = include_str!("../src/shaders/bindings.wgsl");
-    let detector: String = bindings
-        .split("\n\n")
-        .filter(|b| b.contains("loop_cut") || b.contains("fn budget_step"))
-        .collect::<Vec<_>>()
-        .join("\n\n");
+    let detector = loop_detector();
     assert!(detector.contains("fn note_budget"), "{detector}");
     // Neither loop calls note_cut. Their counts have no bound the compiler can see (or it would
     // unroll them) and their results no closed form (or it would drop the loop). Returns 1 when
