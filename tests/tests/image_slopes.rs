@@ -71,3 +71,95 @@ fn value_conditioned_slopes_put_cobblestones_near_the_truth() {
         );
     }
 }
+
+/// Why cobblestones at 85° with the light at the normal is still 7–9% bright (its specular +69%
+/// of itself): the explicit surface sampled on a 400² grid of the tile, split into 8 bins of equal
+/// probability of the value, each bin's specular lobe without masking against the Gaussian of
+/// that bin's own slopes ([`filtered_specular`]), and the visibility along the view of the facets
+/// under the lobe (lobe-weighted) against the bin's average facet. Measurement (docs/design.md,
+/// "Cobblestones at 85°: the grooves' far walls"): `cargo test --release -p lodestone-tests --test
+/// image_slopes -- --ignored --nocapture grazing_specular_by_value`.
+#[test]
+#[ignore = "a measurement: prints the specular lobe and its masking per value bin"]
+fn grazing_specular_by_value() {
+    use glam::{DVec2, DVec3};
+    use lodestone_core::microfacet::brdf::filtered_specular;
+    use lodestone_core::microfacet::slopes::{SlopeCov, normal_of};
+    let path = presets_dir().join("cobblestones.ron");
+    let path = path.to_string_lossy().into_owned();
+    let m = Material::from_ron(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let p = prepare(&path, &m);
+    let s = &p.surface;
+    let n = 400;
+    let mut samples: Vec<(f64, f64, DVec2, DVec2)> = (0..n * n)
+        .map(|k| {
+            let x = DVec2::new(
+                ((k % n) as f64 + 0.37) / n as f64,
+                ((k / n) as f64 + 0.61) / n as f64,
+            );
+            let (f, h, g) = s.sample(x);
+            (f, h, g, x)
+        })
+        .collect();
+    samples.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (view, light, az) in [
+        (85.0f64, 0.0f64, 0.0f64),
+        (85.0, 30.0, 180.0),
+        (75.0, 0.0, 0.0),
+    ] {
+        let wo = direction(view.to_radians(), 0.0);
+        let wi = direction(light.to_radians(), az.to_radians());
+        eprintln!("view {view}°, light {light}°/{az}°:");
+        let bins = 8;
+        for b in 0..bins {
+            let part = &samples[b * samples.len() / bins..(b + 1) * samples.len() / bins];
+            let k = part.len() as f64;
+            let mean = part.iter().map(|q| q.2).sum::<DVec2>() / k;
+            let (mut xx, mut yy, mut xy) = (0.0, 0.0, 0.0);
+            let (mut area, mut lobe, mut lobe_seen, mut area_seen) = (0.0, 0.0, 0.0, 0.0);
+            for &(_f, h, g, x) in part {
+                let d = g - mean;
+                xx += d.x * d.x / k;
+                yy += d.y * d.y / k;
+                xy += d.x * d.y / k;
+                // Projected area toward the eye per unit of the mean plane.
+                let u = wo.z - g.x * wo.x - g.y * wo.y;
+                if u <= 0.0 {
+                    continue;
+                }
+                let spec = m
+                    .brdf
+                    .specular_with(normal_of(g), wo, wi, SlopeCov::default());
+                let seen = if s.sees(DVec3::new(x.x, x.y, h), wo) {
+                    1.0
+                } else {
+                    0.0
+                };
+                area += u;
+                lobe += spec * u;
+                lobe_seen += spec * u * seen;
+                area_seen += u * seen;
+            }
+            let gauss = filtered_specular(
+                m.brdf.specular,
+                m.brdf.roughness,
+                mean,
+                &SlopeCov { xx, yy, xy },
+                wo,
+                wi,
+            );
+            eprintln!(
+                "  bin {b} (f {:+.2} … {:+.2}, slope std {:.3}): lobe truth {:.3e}, its bin's Gaussian {:.3e} \
+                 ({:+.0}%); visibility along the view: lobe-weighted {:.3}, the bin's {:.3}",
+                part[0].0,
+                part[part.len() - 1].0,
+                (0.5 * (xx + yy)).sqrt(),
+                lobe / area,
+                gauss,
+                100.0 * (gauss * area / lobe - 1.0),
+                lobe_seen / lobe.max(1e-300),
+                area_seen / area,
+            );
+        }
+    }
+}
