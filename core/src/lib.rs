@@ -15,6 +15,8 @@
 //! * [`scene`]: directions, camera, shapes, the explicit surface and its march.
 //! * [`eval`]: every method (naive, view-independent, filtered, ground truth) on one footprint
 //!   and one pixel: the reference the GPU is tested against.
+//! * [`object`]: whole objects (#19): base shapes by signed distance, the relief in space, and
+//!   the displaced object's ray trace.
 //!
 //! Papers (plain text in `../shared/papers/`):
 //! * [HN12] Heitz, Neyret. *Representing Appearance and Pre-filtering Subpixel Data in Sparse Voxel Octrees.* HPG 2012.
@@ -25,4 +27,5 @@ pub mod eval;
 pub mod material;
 pub mod math;
 pub mod microfacet;
+pub mod object;
 pub mod scene;

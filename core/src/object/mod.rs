@@ -1,0 +1,8 @@
+//! Whole objects with procedural micro-relief (#19, [HN12]): a closed base shape given by its
+//! signed distance ([`base_shape`]), displaced by the material's relief extended to space
+//! ([`solid_noise`], [`displaced`]). What the object views' ground truth traces; the voxel octree
+//! and its cone tracing [HN12 Secs. 4–5] are built from it.
+
+pub mod base_shape;
+pub mod displaced;
+pub mod solid_noise;
