@@ -137,13 +137,19 @@ impl DisplacedObject {
         self.shape.distance(p) - self.height(p)
     }
 
+    /// ∇F = ∇d_B − σ_h g′(f) ∇f.
+    pub fn gap_gradient(&self, p: DVec3) -> DVec3 {
+        let (f, grad_f) = self.noise.value_and_gradient(p);
+        let gd = self.surface.sigma_h * self.surface.transfer.derivative(f);
+        self.shape.normal(p) - grad_f * gd
+    }
+
     /// The outward unit normal of the level set of F through p: `∇d_B − σ_h g′(f)∇f`, normalised
     /// (the base normal where that vanishes).
     pub fn normal(&self, p: DVec3) -> DVec3 {
-        let (f, grad_f) = self.noise.value_and_gradient(p);
-        let gd = self.surface.sigma_h * self.surface.transfer.derivative(f);
-        let nb = self.shape.normal(p);
-        (nb - grad_f * gd).try_normalize().unwrap_or(nb)
+        self.gap_gradient(p)
+            .try_normalize()
+            .unwrap_or_else(|| self.shape.normal(p))
     }
 
     /// The radius of the sphere that holds the object.
