@@ -7,3 +7,4 @@ pub mod base_shape;
 pub mod displaced;
 pub mod solid_noise;
 pub mod surface_samples;
+pub mod voxel_stats;

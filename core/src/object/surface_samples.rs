@@ -67,7 +67,9 @@ fn base_cell_area(shape: &BaseShape, v: f64, n: usize) -> f64 {
     let cells = (n * n) as f64;
     match *shape {
         BaseShape::Sphere { .. } => shape.area() / cells,
-        BaseShape::Torus { major, minor } => TAU * TAU * minor * (major + minor * (TAU * v).cos()) / cells,
+        BaseShape::Torus { major, minor } => {
+            TAU * TAU * minor * (major + minor * (TAU * v).cos()) / cells
+        }
     }
 }
 
@@ -93,7 +95,10 @@ mod tests {
             let flat = DisplacedObject::new(&m, shape).unwrap();
             let s = flat.surface_samples(120, 1);
             let total: f64 = s.iter().map(|q| q.area).sum();
-            assert!((total / shape.area() - 1.0).abs() < 2e-3, "{shape:?}: {total}");
+            assert!(
+                (total / shape.area() - 1.0).abs() < 2e-3,
+                "{shape:?}: {total}"
+            );
 
             m.heights.sigma_h = 0.02;
             m.slopes.sigma_nx = 0.25;
