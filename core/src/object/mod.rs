@@ -5,6 +5,7 @@
 
 pub mod base_shape;
 pub mod displaced;
+pub mod octree;
 pub mod solid_noise;
 pub mod surface_samples;
 pub mod voxel_stats;
