@@ -4,6 +4,7 @@
 //! and its cone tracing [HN12 Secs. 4–5] are built from it.
 
 pub mod base_shape;
+pub mod coverage_mask;
 pub mod displaced;
 pub mod octree;
 pub mod solid_noise;
