@@ -9,4 +9,5 @@ pub mod displaced;
 pub mod octree;
 pub mod solid_noise;
 pub mod surface_samples;
+pub mod voxel_field;
 pub mod voxel_stats;
