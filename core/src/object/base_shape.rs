@@ -213,11 +213,7 @@ mod tests {
                     3.0 * splitmix(&mut rng) - 1.5,
                 ) * s.bounding_radius();
                 let e = 1e-6;
-                let fd = DVec3::new(
-                    s.distance(p + DVec3::X * e) - s.distance(p - DVec3::X * e),
-                    s.distance(p + DVec3::Y * e) - s.distance(p - DVec3::Y * e),
-                    s.distance(p + DVec3::Z * e) - s.distance(p - DVec3::Z * e),
-                ) / (2.0 * e);
+                let fd = crate::object::central_gradient(|q| s.distance(q), p, e);
                 let n = s.normal(p);
                 assert!((n - fd).length() < 1e-5, "{s:?} at {p}: {n} against {fd}");
                 assert!((n.length() - 1.0).abs() < 1e-12);

@@ -292,11 +292,7 @@ mod tests {
             let p =
                 BaseShape::Sphere { radius: 1.0 }.point_at(splitmix(&mut rng), splitmix(&mut rng));
             let e = 1e-6;
-            let fd = DVec3::new(
-                obj.gap(p + DVec3::X * e) - obj.gap(p - DVec3::X * e),
-                obj.gap(p + DVec3::Y * e) - obj.gap(p - DVec3::Y * e),
-                obj.gap(p + DVec3::Z * e) - obj.gap(p - DVec3::Z * e),
-            ) / (2.0 * e);
+            let fd = crate::object::central_gradient(|q| obj.gap(q), p, e);
             assert!((obj.normal(p) - fd.normalize()).length() < 1e-5);
         }
         let hit = obj.trace(DVec3::new(0.0, 0.0, 3.0), -DVec3::Z).unwrap();

@@ -15,3 +15,18 @@ pub mod surface_samples;
 pub mod view_error;
 pub mod voxel_field;
 pub mod voxel_stats;
+
+/// The central-difference gradient of `f` at p with step e (for the module's tests).
+#[cfg(test)]
+pub(crate) fn central_gradient(
+    f: impl Fn(glam::DVec3) -> f64,
+    p: glam::DVec3,
+    e: f64,
+) -> glam::DVec3 {
+    use glam::DVec3;
+    DVec3::new(
+        f(p + DVec3::X * e) - f(p - DVec3::X * e),
+        f(p + DVec3::Y * e) - f(p - DVec3::Y * e),
+        f(p + DVec3::Z * e) - f(p - DVec3::Z * e),
+    ) / (2.0 * e)
+}

@@ -152,11 +152,7 @@ mod tests {
             let (f, g) = s.value_and_gradient(p);
             assert!((f - s.value(p)).abs() < 1e-12);
             let e = 1e-6;
-            let fd = DVec3::new(
-                s.value(p + DVec3::X * e) - s.value(p - DVec3::X * e),
-                s.value(p + DVec3::Y * e) - s.value(p - DVec3::Y * e),
-                s.value(p + DVec3::Z * e) - s.value(p - DVec3::Z * e),
-            ) / (2.0 * e);
+            let fd = crate::object::central_gradient(|q| s.value(q), p, e);
             assert!((g - fd).length() < 1e-5 * (1.0 + g.length()), "{g} {fd}");
             assert!(g.length() <= bound && f.abs() <= s.amplitude_bound());
         }
