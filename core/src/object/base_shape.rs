@@ -7,11 +7,13 @@
 //! sphere's centre, a torus's axis or its core circle) [`BaseShape::normal`] returns a fixed unit
 //! vector, so it is finite on every input.
 
+use crate::object::mesh::TriMesh;
 use glam::{DVec2, DVec3};
 use serde::{Deserialize, Serialize};
+use std::sync::Arc;
 
 /// A closed base shape, centred at the origin.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum BaseShape {
     /// A sphere of this radius.
@@ -27,6 +29,10 @@ pub enum BaseShape {
         /// Radius of the tube (> 0).
         minor: f64,
     },
+    /// A closed triangle mesh (checked when it was loaded: [`TriMesh::new`]); a preset names its
+    /// file, so the mesh itself is never written.
+    #[serde(skip)]
+    Mesh(Arc<TriMesh>),
 }
 
 impl Default for BaseShape {
@@ -67,6 +73,7 @@ impl BaseShape {
             }
         };
         match *self {
+            Self::Mesh(_) => Ok(()),
             Self::Sphere { radius } => positive("the sphere's radius", radius),
             Self::Torus { major, minor } => {
                 positive("the torus's major radius", major)?;
@@ -83,6 +90,7 @@ impl BaseShape {
     /// The signed distance to the surface (negative inside), exact.
     pub fn distance(&self, p: DVec3) -> f64 {
         match *self {
+            Self::Mesh(ref m) => m.distance(p),
             Self::Sphere { radius } => p.length() - radius,
             Self::Torus { major, minor } => {
                 DVec2::new(DVec2::new(p.x, p.y).length() - major, p.z).length() - minor
@@ -95,6 +103,7 @@ impl BaseShape {
     /// centre, +x from the torus's axis, and radially outward in the z = 0 plane on its core circle.
     pub fn normal(&self, p: DVec3) -> DVec3 {
         match *self {
+            Self::Mesh(ref m) => m.normal(p),
             Self::Sphere { .. } => p.try_normalize().unwrap_or(DVec3::Z),
             Self::Torus { major, .. } => {
                 let radial = DVec2::new(p.x, p.y).try_normalize().unwrap_or(DVec2::X);
@@ -110,6 +119,7 @@ impl BaseShape {
     /// The radius of the smallest origin-centred sphere that holds the shape.
     pub fn bounding_radius(&self) -> f64 {
         match *self {
+            Self::Mesh(ref m) => m.bounding_radius(),
             Self::Sphere { radius } => radius,
             Self::Torus { major, minor } => major + minor,
         }
@@ -119,18 +129,58 @@ impl BaseShape {
     pub fn area(&self) -> f64 {
         use std::f64::consts::PI;
         match *self {
+            Self::Mesh(ref m) => m.area(),
             Self::Sphere { radius } => 4.0 * PI * radius * radius,
             Self::Torus { major, minor } => 4.0 * PI * PI * major * minor,
         }
     }
 
+    /// The smallest radius of curvature, or for a mesh half its least thickness
+    /// ([`TriMesh::thickness`]): how far a relief may reach before the displaced surface folds.
+    pub fn feature_radius(&self) -> f64 {
+        match *self {
+            Self::Mesh(ref m) => 0.5 * m.thickness(),
+            Self::Sphere { radius } => radius,
+            Self::Torus { major, minor } => minor.min(major - minor),
+        }
+    }
+
+    /// `n × n` points spread over the surface, each with the area it stands for (summing to the
+    /// surface's): an analytic shape's parameter cells ([`BaseShape::point_at`]), one jittered
+    /// point each; a mesh's triangles by area ([`TriMesh::surface_points`]).
+    pub fn surface_points(&self, n: usize, seed: u64) -> Vec<(DVec3, f64)> {
+        use crate::math::random::splitmix;
+        use std::f64::consts::TAU;
+        if let Self::Mesh(m) = self {
+            return m.surface_points(n * n, seed);
+        }
+        let mut rng = seed;
+        let cells = (n * n) as f64;
+        let mut out = Vec::with_capacity(n * n);
+        for j in 0..n {
+            for i in 0..n {
+                let u = (i as f64 + splitmix(&mut rng)) / n as f64;
+                let v = (j as f64 + splitmix(&mut rng)) / n as f64;
+                let area = match *self {
+                    Self::Torus { major, minor } => {
+                        TAU * TAU * minor * (major + minor * (TAU * v).cos()) / cells
+                    }
+                    _ => self.area() / cells,
+                };
+                out.push((self.point_at(u, v), area));
+            }
+        }
+        out
+    }
+
     /// The surface point at parameters (u, v) ∈ [0, 1)² (a sphere's longitude and the cosine of
     /// its colatitude, which is area-preserving; a torus's angles around the axis and around the
     /// tube): for sampling the surface in tests and statistics. Each call returns a point on the
-    /// surface (distance 0 up to rounding).
+    /// surface (distance 0 up to rounding). A mesh has no parameters: its first vertex.
     pub fn point_at(&self, u: f64, v: f64) -> DVec3 {
         use std::f64::consts::TAU;
         match *self {
+            Self::Mesh(ref m) => m.vertices[0],
             Self::Sphere { radius } => {
                 let (z, phi) = (1.0 - 2.0 * v, TAU * u);
                 let s = (1.0 - z * z).max(0.0).sqrt();

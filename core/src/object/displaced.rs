@@ -88,10 +88,7 @@ impl DisplacedObject {
             crate::material::Driver::Image { .. } => 0,
         };
         let noise = SolidNoise::from_plane(plane, seed);
-        let radius = match shape {
-            BaseShape::Sphere { radius } => radius,
-            BaseShape::Torus { major, minor } => minor.min(major - minor),
-        };
+        let radius = shape.feature_radius();
         let reach = match &surface.transfer {
             crate::material::transfer::TransferFunction::Identity => {
                 surface.h_max.min(4.0 * surface.sigma_h)
@@ -228,7 +225,7 @@ mod tests {
     fn the_trace_finds_the_first_crossing() {
         let mut rng = 21u64;
         for shape in shapes() {
-            let obj = object(shape);
+            let obj = object(shape.clone());
             let mut hits = 0;
             for _ in 0..150 {
                 let dir = |rng: &mut u64| {

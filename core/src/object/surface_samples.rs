@@ -1,8 +1,8 @@
 //! Area-weighted samples of a displaced object's surface (#19): what the voxel octree's statistics
 //! are summed from, and what tests measure those statistics against.
 //!
-//! The base surface is cut into `n × n` cells of its parameters ([`BaseShape::point_at`]), one
-//! point per cell at a jittered position. Each base point b with normal m is carried to the
+//! The base surface is spread with `n × n` points ([`BaseShape::surface_points`]: jittered
+//! parameter cells, or a mesh's triangles by area). Each base point b with normal m is carried to the
 //! displaced surface by tracing from `b + (reach + margin)·m` back along −m
 //! ([`DisplacedObject::trace`]: the outermost crossing, the point a ray along the normal sees).
 //! Its area is the base cell's times the displaced surface's area element, `|∇F|/(m·∇F)` (the
@@ -10,11 +10,8 @@
 //! factor `1 + κh` is left out: O(σ_h/R), 2% at the relief's limit of a quarter radius).
 //! Cells whose trace finds nothing (none on a valid object) are dropped.
 
-use crate::math::random::splitmix;
-use crate::object::base_shape::BaseShape;
 use crate::object::displaced::DisplacedObject;
 use glam::DVec3;
-use std::f64::consts::TAU;
 
 /// One sample of the surface.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -32,44 +29,23 @@ pub struct SurfaceSample {
 impl DisplacedObject {
     /// `n × n` samples of the surface (module docs), jittered with `seed`.
     pub fn surface_samples(&self, n: usize, seed: u64) -> Vec<SurfaceSample> {
-        let mut rng = seed;
         let reach = self.surface.h_max + 1e-3 * self.shape.bounding_radius();
-        let mut out = Vec::with_capacity(n * n);
-        for j in 0..n {
-            for i in 0..n {
-                let u = (i as f64 + splitmix(&mut rng)) / n as f64;
-                let v = (j as f64 + splitmix(&mut rng)) / n as f64;
-                let b = self.shape.point_at(u, v);
+        self.shape
+            .surface_points(n, seed)
+            .into_iter()
+            .filter_map(|(b, base_area)| {
                 let m = self.shape.normal(b);
-                let Some(hit) = self.trace(b + m * reach, -m) else {
-                    continue;
-                };
+                let hit = self.trace(b + m * reach, -m)?;
                 let grad = self.gap_gradient(hit.p);
                 let cosine = m.dot(grad);
-                if !(cosine > 1e-6) {
-                    continue;
-                }
-                out.push(SurfaceSample {
+                (cosine > 1e-6).then(|| SurfaceSample {
                     p: hit.p,
                     n: grad.normalize(),
-                    area: base_cell_area(&self.shape, v, n) * grad.length() / cosine,
+                    area: base_area * grad.length() / cosine,
                     f: self.value(hit.p),
-                });
-            }
-        }
-        out
-    }
-}
-
-/// The area of one of the `n × n` parameter cells of the base surface at parameter v (exact for
-/// the sphere, whose parameters are area-preserving; the torus's element at the cell's v).
-fn base_cell_area(shape: &BaseShape, v: f64, n: usize) -> f64 {
-    let cells = (n * n) as f64;
-    match *shape {
-        BaseShape::Sphere { .. } => shape.area() / cells,
-        BaseShape::Torus { major, minor } => {
-            TAU * TAU * minor * (major + minor * (TAU * v).cos()) / cells
-        }
+                })
+            })
+            .collect()
     }
 }
 
@@ -77,6 +53,7 @@ fn base_cell_area(shape: &BaseShape, v: f64, n: usize) -> f64 {
 mod tests {
     use super::*;
     use crate::material::Material;
+    use crate::object::base_shape::BaseShape;
 
     /// The samples lie on the surface, their normals are the surface's, and their areas add up to
     /// the base's area when the relief is flat and to more (the relief's area element, 1 + σ²/2 to
@@ -92,7 +69,7 @@ mod tests {
         ] {
             let mut m = Material::default();
             m.heights.sigma_h = 0.0;
-            let flat = DisplacedObject::new(&m, shape).unwrap();
+            let flat = DisplacedObject::new(&m, shape.clone()).unwrap();
             let s = flat.surface_samples(120, 1);
             let total: f64 = s.iter().map(|q| q.area).sum();
             assert!(
@@ -103,7 +80,7 @@ mod tests {
             m.heights.sigma_h = 0.02;
             m.slopes.sigma_nx = 0.25;
             m.slopes.sigma_ny = 0.25;
-            let bumpy = DisplacedObject::new(&m, shape).unwrap();
+            let bumpy = DisplacedObject::new(&m, shape.clone()).unwrap();
             let s = bumpy.surface_samples(200, 2);
             assert!(s.len() == 200 * 200, "{}", s.len());
             for q in &s {
