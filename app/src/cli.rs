@@ -242,6 +242,52 @@ pub enum Command {
     Show,
     /// Describe the GPU adapter wgpu finds; exit code 3 when there is none.
     Adapter,
+    /// A whole object (sphere, torus or a closed OBJ mesh) displaced by the preset's relief,
+    /// voxelised into a sparse octree and cone traced on the CPU [HN12] beside its ray-traced
+    /// ground truth, over a zoom sweep: per distance a PNG strip (nearest voxels | alpha blended |
+    /// masks | ground truth) and the colour error of covered pixels, the silhouette's coverage
+    /// error and the time per pixel. Noise drivers only; a bad mesh is exit code 2.
+    Object {
+        /// The base shape.
+        #[arg(long, value_enum, default_value_t = ObjectShapeArg::Sphere)]
+        shape: ObjectShapeArg,
+        /// The closed, consistently oriented OBJ mesh of `--shape mesh`.
+        #[arg(long)]
+        mesh: Option<PathBuf>,
+        /// The sphere's radius, or the torus's major radius (world units).
+        #[arg(long, default_value_t = 1.0, value_parser = radius)]
+        radius: f64,
+        /// The torus's minor radius (world units, below the major).
+        #[arg(long, default_value_t = 0.4, value_parser = radius)]
+        minor: f64,
+        /// Octree depth (finest voxels: the object's bounding cube over 2^depth; 2 to 10).
+        #[arg(long, default_value_t = 7, value_parser = clap::value_parser!(u32).range(2..=10))]
+        depth: u32,
+        /// Image size of each panel, WxH.
+        #[arg(long, default_value = "160x120", value_parser = parse_size)]
+        size: (u32, u32),
+        /// Camera distances from the object's centre, comma-separated (world units).
+        #[arg(long, default_value = "8,4,2", value_delimiter = ',', value_parser = distance)]
+        distances: Vec<f64>,
+        /// Camera angle from +z, degrees (0 to 89.5).
+        #[arg(long, default_value_t = 60.0, value_parser = view_angle)]
+        view_deg: f64,
+        /// Camera azimuth, degrees.
+        #[arg(long, default_value_t = 30.0, value_parser = azimuth)]
+        view_azimuth_deg: f64,
+        /// Sun angle from +z, degrees (0 to 180).
+        #[arg(long, default_value_t = 37.0, value_parser = light_angle)]
+        light_deg: f64,
+        /// Sun azimuth, degrees.
+        #[arg(long, default_value_t = -37.0, value_parser = azimuth)]
+        light_azimuth_deg: f64,
+        /// Ground-truth rays per pixel (1 to 4096).
+        #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=4096))]
+        rays: u32,
+        /// Folder for the PNG strips (created if needed; none: only the table).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Error against run time: naive, view-independent, both filtered variants and ground truth at
     /// 1…256 rays against a ground-truth reference over view/light configurations and zoom levels;
     /// writes report.json, report.md and SVG charts into --out.
@@ -404,6 +450,28 @@ impl InterceptionArg {
         match self {
             Self::Off => lodestone_core::eval::interception::Interception::Off,
             Self::Crests => lodestone_core::eval::interception::Interception::Crests,
+        }
+    }
+}
+
+/// The base shape `object` displaces.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ObjectShapeArg {
+    /// A sphere of `--radius`.
+    Sphere,
+    /// A ring torus of `--radius` and `--minor` around z.
+    Torus,
+    /// The closed OBJ mesh of `--mesh`.
+    Mesh,
+}
+
+impl ObjectShapeArg {
+    /// Its name for [`crate::object_cmd::shape`].
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Sphere => "sphere",
+            Self::Torus => "torus",
+            Self::Mesh => "mesh",
         }
     }
 }

@@ -23,6 +23,7 @@ mod dolly;
 mod editor;
 mod eval;
 mod inspect;
+mod object_cmd;
 mod preset_io;
 mod render_cmd;
 mod report;
@@ -421,6 +422,33 @@ fn run(cli: Cli) -> Result<()> {
                 "wrote report.json, report.md and the charts (error_vs_time, error_vs_view, error_vs_rays; SVG and PNG) to {}",
                 out.display()
             );
+        }
+        Some(Command::Object {
+            shape,
+            mesh,
+            radius,
+            minor,
+            depth,
+            size,
+            distances,
+            view_deg,
+            view_azimuth_deg,
+            light_deg,
+            light_azimuth_deg,
+            rays,
+            out,
+        }) => {
+            let opts = object_cmd::Options {
+                shape: object_cmd::shape(shape.name(), mesh.as_deref(), radius, minor)?,
+                depth,
+                size,
+                distances,
+                view: (view_deg, view_azimuth_deg),
+                light: (light_deg, light_azimuth_deg),
+                rays: rays as usize,
+                out,
+            };
+            out!("{}", object_cmd::run(material, &opts)?);
         }
         Some(Command::Adapter) => {
             let ctx = lodestone_render::GpuContext::new_headless()?;

@@ -1251,3 +1251,87 @@ fn the_readme_eval_example_is_current() {
         "README's eval example is stale: rerun with UPDATE_README=1"
     );
 }
+
+/// `object` (#19): a bad mesh, shape or material is a usage error (exit code 2) naming the
+/// problem; a small sweep writes its strip and prints its table.
+#[test]
+fn object_refuses_bad_input_and_renders_a_small_sweep() {
+    let dir = std::env::temp_dir().join(format!("lodestone-object-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let cube = "v -1 -1 -1\nv 1 -1 -1\nv -1 1 -1\nv 1 1 -1\nv -1 -1 1\nv 1 -1 1\nv -1 1 1\nv 1 1 1\n\
+                f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\n";
+    let cases: [(&str, &str, &str); 4] = [
+        ("open.obj", cube, "not closed"),
+        ("empty.obj", "# nothing\n", "no triangles"),
+        ("bad.obj", "v 1 2\nf 1 2 3\n", "does not parse"),
+        (
+            "huge.obj",
+            &cube.replace("v 1 1 1", "v 1e300 1 1"),
+            "finite point",
+        ),
+    ];
+    for (name, text, says) in cases {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        let out = lodestone(&[
+            "object",
+            "--shape",
+            "mesh",
+            "--mesh",
+            path.to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+        assert!(err.contains(says) && err.contains(name), "{name}: {err}");
+    }
+    for (args, says) in [
+        (vec!["object", "--shape", "mesh"], "--mesh"),
+        (
+            vec!["object", "--shape", "mesh", "--mesh", "/nonexistent/x.obj"],
+            "cannot read",
+        ),
+        (
+            vec![
+                "object", "--shape", "torus", "--radius", "1", "--minor", "2",
+            ],
+            "minor radius",
+        ),
+    ] {
+        let out = lodestone(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+    }
+    let image = concat!(env!("CARGO_MANIFEST_DIR"), "/../presets/cobblestones.ron");
+    let out = lodestone(&["--preset", image, "object"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("noise driver"));
+
+    let strips = dir.join("strips");
+    let out = lodestone(&[
+        "object",
+        "--size",
+        "16x12",
+        "--distances",
+        "6",
+        "--depth",
+        "4",
+        "--rays",
+        "4",
+        "--out",
+        strips.to_str().unwrap(),
+    ]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        text.contains("| 6 |") && text.contains("octree depth 4"),
+        "{text}"
+    );
+    let png = image::open(strips.join("object-d6.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (4 * 16 + 3 * 4, 12));
+    std::fs::remove_dir_all(&dir).ok();
+}

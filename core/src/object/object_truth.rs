@@ -20,7 +20,7 @@ pub struct ObjectTruth<'a> {
     /// Sun and BRDF.
     pub lighting: &'a ObjectLighting,
     /// The point colour of a driver value (the material's colour map).
-    pub color: &'a dyn Fn(f64) -> [f64; 3],
+    pub color: &'a (dyn Fn(f64) -> [f64; 3] + Sync),
     /// Shadow rays toward the sun (off: the sun is always visible).
     pub shadows: bool,
 }

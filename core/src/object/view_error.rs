@@ -22,7 +22,7 @@ pub struct ModeErrors {
     pub relative_rmse: f64,
     /// Mean |coverage − truth's| over the silhouette pixels.
     pub coverage_error: f64,
-    /// Wall time of the mode's cones over the image, seconds (one thread).
+    /// CPU time of the mode's cones over the image, seconds (summed over threads).
     pub seconds: f64,
 }
 
@@ -37,86 +37,138 @@ pub struct ViewErrors {
     pub modes: Vec<ModeErrors>,
 }
 
-/// Renders a `width × height` image of `camera` with the truth (`rays` a pixel) and each of
-/// `modes`, and measures them (module docs).
+/// The images of one camera: the truth's pixels and each mode's, row-major.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ObjectImages {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// The ground truth.
+    pub truth: Vec<ConePixel>,
+    /// Per mode: its pixels and the CPU seconds its cones took (summed over threads).
+    pub views: Vec<(Compositing, Vec<ConePixel>, f64)>,
+}
+
+impl ObjectImages {
+    /// Renders a `width × height` image of `camera` with the truth (`rays` a pixel) and each of
+    /// `modes`, rows in parallel.
+    pub fn render(
+        truth: &ObjectTruth,
+        tracer: &ConeTracer,
+        camera: &Camera,
+        (width, height): (u32, u32),
+        rays: usize,
+        modes: &[Compositing],
+    ) -> Self {
+        use rayon::prelude::*;
+        let rows: Vec<(Vec<ConePixel>, Vec<Vec<ConePixel>>, Vec<f64>)> = (0..height)
+            .into_par_iter()
+            .map(|y| {
+                let mut t_row = Vec::with_capacity(width as usize);
+                let mut v_rows = vec![Vec::with_capacity(width as usize); modes.len()];
+                let mut secs = vec![0.0; modes.len()];
+                for x in 0..width {
+                    let cone = pixel_cone(camera, x as f64 + 0.5, y as f64 + 0.5, width, height);
+                    t_row.push(truth.pixel(&cone, rays, u64::from(y * width + x)));
+                    for (i, m) in modes.iter().enumerate() {
+                        let t = std::time::Instant::now();
+                        v_rows[i].push(tracer.trace(&cone, *m));
+                        secs[i] += t.elapsed().as_secs_f64();
+                    }
+                }
+                (t_row, v_rows, secs)
+            })
+            .collect();
+        let mut truth_px = Vec::with_capacity((width * height) as usize);
+        let mut views: Vec<(Compositing, Vec<ConePixel>, f64)> =
+            modes.iter().map(|m| (*m, Vec::new(), 0.0)).collect();
+        for (t_row, v_rows, secs) in rows {
+            truth_px.extend(t_row);
+            for (i, (row, s)) in v_rows.into_iter().zip(secs).enumerate() {
+                views[i].1.extend(row);
+                views[i].2 += s;
+            }
+        }
+        Self {
+            width,
+            height,
+            truth: truth_px,
+            views,
+        }
+    }
+
+    /// Each mode's errors against the truth (module docs).
+    pub fn errors(&self) -> ViewErrors {
+        let truth_px = &self.truth;
+        let covered: Vec<usize> = (0..truth_px.len())
+            .filter(|&i| truth_px[i].coverage >= 0.99)
+            .collect();
+        let mut sums_t = [0.0; 3];
+        for &i in &covered {
+            for k in 0..3 {
+                sums_t[k] += truth_px[i].color[k];
+            }
+        }
+        let mean_t = (sums_t.iter().sum::<f64>() / (3.0 * covered.len().max(1) as f64)).max(1e-300);
+        let modes = self
+            .views
+            .iter()
+            .map(|(mode, v, seconds)| {
+                let mut sums = [0.0; 3];
+                let mut sq = 0.0;
+                for &i in &covered {
+                    for k in 0..3 {
+                        sums[k] += v[i].color[k];
+                        sq += (v[i].color[k] - truth_px[i].color[k]).powi(2);
+                    }
+                }
+                let mean_color_error = (0..3)
+                    .map(|k| (sums[k] - sums_t[k]).abs() / sums_t[k].max(1e-300))
+                    .fold(0.0, f64::max);
+                let relative_rmse = (sq / (3.0 * covered.len().max(1) as f64)).sqrt() / mean_t;
+                let sil: Vec<usize> = (0..truth_px.len())
+                    .filter(|&i| {
+                        let t = truth_px[i].coverage;
+                        (t > 0.0 && t < 0.99) || (t == 0.0 && v[i].coverage > 0.0)
+                    })
+                    .collect();
+                let coverage_error = sil
+                    .iter()
+                    .map(|&i| (v[i].coverage - truth_px[i].coverage).abs())
+                    .sum::<f64>()
+                    / sil.len().max(1) as f64;
+                ModeErrors {
+                    mode: *mode,
+                    mean_color_error,
+                    relative_rmse,
+                    coverage_error,
+                    seconds: *seconds,
+                }
+            })
+            .collect();
+        let silhouette = truth_px
+            .iter()
+            .filter(|t| t.coverage > 0.0 && t.coverage < 0.99)
+            .count();
+        ViewErrors {
+            covered: covered.len(),
+            silhouette,
+            modes,
+        }
+    }
+}
+
+/// Renders with [`ObjectImages::render`] and measures with [`ObjectImages::errors`].
 pub fn view_errors(
     truth: &ObjectTruth,
     tracer: &ConeTracer,
     camera: &Camera,
-    (width, height): (u32, u32),
+    size: (u32, u32),
     rays: usize,
     modes: &[Compositing],
 ) -> ViewErrors {
-    let mut truth_px = Vec::with_capacity((width * height) as usize);
-    let mut views: Vec<Vec<ConePixel>> = vec![Vec::new(); modes.len()];
-    let mut seconds = vec![0.0; modes.len()];
-    for y in 0..height {
-        for x in 0..width {
-            let cone = pixel_cone(camera, x as f64 + 0.5, y as f64 + 0.5, width, height);
-            truth_px.push(truth.pixel(&cone, rays, u64::from(y * width + x)));
-            for (i, (m, v)) in modes.iter().zip(views.iter_mut()).enumerate() {
-                let t = std::time::Instant::now();
-                v.push(tracer.trace(&cone, *m));
-                seconds[i] += t.elapsed().as_secs_f64();
-            }
-        }
-    }
-    let covered: Vec<usize> = (0..truth_px.len())
-        .filter(|&i| truth_px[i].coverage >= 0.99)
-        .collect();
-    let mut sums_t = [0.0; 3];
-    for &i in &covered {
-        for k in 0..3 {
-            sums_t[k] += truth_px[i].color[k];
-        }
-    }
-    let mean_t = (sums_t.iter().sum::<f64>() / (3.0 * covered.len().max(1) as f64)).max(1e-300);
-    let modes = modes
-        .iter()
-        .zip(&views)
-        .zip(seconds)
-        .map(|((&mode, v), seconds)| {
-            let mut sums = [0.0; 3];
-            let mut sq = 0.0;
-            for &i in &covered {
-                for k in 0..3 {
-                    sums[k] += v[i].color[k];
-                    sq += (v[i].color[k] - truth_px[i].color[k]).powi(2);
-                }
-            }
-            let mean_color_error = (0..3)
-                .map(|k| (sums[k] - sums_t[k]).abs() / sums_t[k].max(1e-300))
-                .fold(0.0, f64::max);
-            let relative_rmse = (sq / (3.0 * covered.len().max(1) as f64)).sqrt() / mean_t;
-            let sil: Vec<usize> = (0..truth_px.len())
-                .filter(|&i| {
-                    let t = truth_px[i].coverage;
-                    (t > 0.0 && t < 0.99) || (t == 0.0 && v[i].coverage > 0.0)
-                })
-                .collect();
-            let coverage_error = sil
-                .iter()
-                .map(|&i| (v[i].coverage - truth_px[i].coverage).abs())
-                .sum::<f64>()
-                / sil.len().max(1) as f64;
-            ModeErrors {
-                mode,
-                mean_color_error,
-                relative_rmse,
-                coverage_error,
-                seconds,
-            }
-        })
-        .collect();
-    let silhouette = truth_px
-        .iter()
-        .filter(|t| t.coverage > 0.0 && t.coverage < 0.99)
-        .count();
-    ViewErrors {
-        covered: covered.len(),
-        silhouette,
-        modes,
-    }
+    ObjectImages::render(truth, tracer, camera, size, rays, modes).errors()
 }
 
 #[cfg(test)]
