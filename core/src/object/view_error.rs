@@ -62,7 +62,9 @@ impl ObjectImages {
         modes: &[Compositing],
     ) -> Self {
         use rayon::prelude::*;
-        let rows: Vec<(Vec<ConePixel>, Vec<Vec<ConePixel>>, Vec<f64>)> = (0..height)
+        // Per row: the truth's pixels, each mode's pixels, each mode's seconds.
+        type Row = (Vec<ConePixel>, Vec<Vec<ConePixel>>, Vec<f64>);
+        let rows: Vec<Row> = (0..height)
             .into_par_iter()
             .map(|y| {
                 let mut t_row = Vec::with_capacity(width as usize);
