@@ -257,8 +257,9 @@ pub enum Command {
         /// The sphere's radius, or the torus's major radius (world units).
         #[arg(long, default_value_t = 1.0, value_parser = radius)]
         radius: f64,
-        /// The torus's minor radius (world units, below the major).
-        #[arg(long, default_value_t = 0.4, value_parser = radius)]
+        /// The torus's minor radius (world units, below the major; the relief may reach a quarter
+        /// of the smaller of it and the hole's radius, major − minor).
+        #[arg(long, default_value_t = 0.45, value_parser = radius)]
         minor: f64,
         /// Octree depth (finest voxels: the object's bounding cube over 2^depth; 2 to 10).
         #[arg(long, default_value_t = 7, value_parser = clap::value_parser!(u32).range(2..=10))]

@@ -38,7 +38,7 @@ pub enum ObjectError {
     ImageDriver,
     /// The relief is too tall for the shape.
     #[error(
-        "the relief (up to {h_max}) exceeds {MAX_RELIEF_FRACTION} of the shape's smallest radius of curvature ({radius}): lower σ_h or grow the shape"
+        "the relief (reaching {h_max}) exceeds {MAX_RELIEF_FRACTION} of the shape's smallest radius of curvature or half its thickness ({radius}): lower σ_h or grow the shape"
     )]
     ReliefTooTall {
         /// How far the relief reaches ([`MAX_RELIEF_FRACTION`]'s docs).

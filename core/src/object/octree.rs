@@ -62,10 +62,9 @@ impl VoxelOctree {
         };
         for s in samples {
             if let Some(key) = tree.voxel_of(depth, s.p) {
-                tree.levels[depth as usize]
-                    .entry(key)
-                    .or_default()
-                    .add(&SurfaceMoments::of_sample(s.p, s.n, s.area, color(s.f)));
+                tree.levels[depth as usize].entry(key).or_default().add(
+                    &SurfaceMoments::of_sample(s.p, s.n, s.m, s.area, color(s.f)),
+                );
             }
         }
         for l in (0..depth as usize).rev() {
@@ -183,7 +182,13 @@ mod tests {
                 let mut m = SurfaceMoments::default();
                 for s in &dense {
                     if tree.voxel_of(level, s.p) == Some(*key) {
-                        m.add(&SurfaceMoments::of_sample(s.p, s.n, s.area, color(s.f)));
+                        m.add(&SurfaceMoments::of_sample(
+                            s.p,
+                            s.n,
+                            s.m,
+                            s.area,
+                            color(s.f),
+                        ));
                     }
                 }
                 let (Some(a), Some(b)) = (tree.descriptor(level, *key), m.descriptor()) else {
@@ -262,6 +267,7 @@ mod tests {
                 let p = DVec3::new(x, y, z);
                 piece.add(&SurfaceMoments::of_sample(
                     p,
+                    p / r,
                     p / r,
                     (size / k as f64).powi(2) * r / z,
                     [0.5; 3],

@@ -20,6 +20,8 @@ pub struct SurfaceSample {
     pub p: DVec3,
     /// Its outward unit normal.
     pub n: DVec3,
+    /// The base surface's unit normal under it (what its slope is measured against).
+    pub m: DVec3,
     /// The surface area it stands for.
     pub area: f64,
     /// The driver's value there.
@@ -41,6 +43,7 @@ impl DisplacedObject {
                 (cosine > 1e-6).then(|| SurfaceSample {
                     p: hit.p,
                     n: grad.normalize(),
+                    m,
                     area: base_area * grad.length() / cosine,
                     f: self.value(hit.p),
                 })
