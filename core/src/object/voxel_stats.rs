@@ -241,20 +241,22 @@ mod tests {
     use super::*;
     use crate::math::random::{splitmix, standard_normal};
 
-    /// A piece of surface as weighted samples: point, normal, base normal, area, colour.
-    type Piece = Vec<(DVec3, DVec3, DVec3, f64, [f64; 3])>;
+    /// A weighted sample: point, normal, base normal, area, colour.
+    type Sample = (DVec3, DVec3, DVec3, f64, [f64; 3]);
+    /// A piece of surface as weighted samples.
+    type Piece = Vec<Sample>;
 
     /// The descriptor by two-pass formulas straight from the samples (the brute force the sums
     /// must reproduce).
     fn brute(s: &Piece) -> VoxelDescriptor {
         let area: f64 = s.iter().map(|q| q.3).sum();
-        let mean = |f: &dyn Fn(&(DVec3, DVec3, DVec3, f64, [f64; 3])) -> DVec3| {
+        let mean = |f: &dyn Fn(&Sample) -> DVec3| {
             s.iter().map(|q| f(q) * q.3).sum::<DVec3>() / area
         };
         let c = mean(&|q| q.0);
         let mn = mean(&|q| q.1);
         let mm = mean(&|q| q.2);
-        let slope = |q: &(DVec3, DVec3, DVec3, f64, [f64; 3])| {
+        let slope = |q: &Sample| {
             let k = q.1.dot(q.2);
             -(q.1 - q.2 * k) / k
         };
