@@ -288,6 +288,10 @@ pub enum Command {
         /// Folder for the PNG strips (created if needed; none: only the table).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Leave out shadows (shadow rays in the truth, shadow cones in the voxel views) in both,
+        /// to see what they carry of the error.
+        #[arg(long)]
+        no_shadows: bool,
     },
     /// Error against run time: naive, view-independent, both filtered variants and ground truth at
     /// 1…256 rays against a ground-truth reference over view/light configurations and zoom levels;

@@ -437,8 +437,10 @@ fn run(cli: Cli) -> Result<()> {
             light_azimuth_deg,
             rays,
             out,
+            no_shadows,
         }) => {
             let opts = object_cmd::Options {
+                shadows: !no_shadows,
                 shape: object_cmd::shape(shape.name(), mesh.as_deref(), radius, minor)?,
                 depth,
                 size,

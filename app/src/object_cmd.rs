@@ -52,6 +52,8 @@ pub struct Options {
     pub rays: usize,
     /// Output folder for the strips (none: only the table).
     pub out: Option<PathBuf>,
+    /// Shadows in both the truth and the voxel views.
+    pub shadows: bool,
 }
 
 /// The base shape named on the command line; a mesh is read and checked here.
@@ -102,13 +104,13 @@ pub fn run(material: &Material, opts: &Options) -> Result<String> {
         field: &field,
         table: &table,
         lighting: &lighting,
-        shadows: true,
+        shadows: opts.shadows,
     };
     let truth = ObjectTruth {
         object: &object,
         lighting: &lighting,
         color: &color,
-        shadows: true,
+        shadows: opts.shadows,
     };
     let mut text = String::new();
     let bytes: usize = tree.memory().iter().map(|l| l.gpu_bytes).sum();

@@ -250,9 +250,8 @@ mod tests {
     /// must reproduce).
     fn brute(s: &Piece) -> VoxelDescriptor {
         let area: f64 = s.iter().map(|q| q.3).sum();
-        let mean = |f: &dyn Fn(&Sample) -> DVec3| {
-            s.iter().map(|q| f(q) * q.3).sum::<DVec3>() / area
-        };
+        let mean =
+            |f: &dyn Fn(&Sample) -> DVec3| s.iter().map(|q| f(q) * q.3).sum::<DVec3>() / area;
         let c = mean(&|q| q.0);
         let mn = mean(&|q| q.1);
         let mm = mean(&|q| q.2);
