@@ -84,7 +84,7 @@ impl ConeTracer<'_> {
         let (e1, e2) = cone.dir.any_orthonormal_pair();
         let mut covered = 0u64;
         let mut opacity = 0.0;
-        self.march(cone, mode, |s, c, r, level| {
+        self.march(cone, mode, |s, c, r, _level| {
             let mask = match mode {
                 Compositing::Nearest => u64::MAX,
                 _ => {
@@ -111,7 +111,7 @@ impl ConeTracer<'_> {
             };
             if weight > 0.0 {
                 let sun = if self.shadows {
-                    self.sun_visibility(c - s.normal * s.distance, r, level, mode)
+                    self.sun_visibility(c - s.normal * s.distance, s.normal, r, mode)
                 } else {
                     1.0
                 };
@@ -135,10 +135,15 @@ impl ConeTracer<'_> {
     /// The share of the sun an element of radius r sees from c, the point of its mean plane under
     /// its centre: a shadow cone of the same radius toward the sun, from one element length out,
     /// composited as the view's cone is.
-    fn sun_visibility(&self, c: DVec3, r: f64, _level: f64, mode: Compositing) -> f64 {
+    fn sun_visibility(&self, c: DVec3, normal: DVec3, r: f64, mode: Compositing) -> f64 {
         let light = self.lighting.light;
+        // Start where the element's own mean plane can no longer cover the shadow cone's disc
+        // (its micro-shadowing is V̄(l)'s): an element of radius r whose centre is t along the
+        // light clears a plane at cosine c to the light once `t·c ≥ r·c + r·√(1 − c²)`.
+        let cos = normal.dot(light).max(1.0 / 16.0);
+        let start = r * (1.0 + (1.0 - cos * cos).max(0.0).sqrt() / cos);
         let shadow = Cone {
-            origin: c + light * (2.0 * r),
+            origin: c + light * start,
             dir: light,
             radius0: r,
             spread: 0.0,
