@@ -128,9 +128,9 @@ pub fn run(material: &Material, opts: &Options) -> Result<String> {
     )?;
     writeln!(
         text,
-        "| distance | across | covered / silhouette px | mean colour error: nearest / alpha / masks | silhouette coverage error: nearest / alpha / masks | µs a pixel (CPU): nearest / alpha / masks |"
+        "| distance | across | covered / silhouette px | truth's s.e. | mean colour error: nearest / alpha / masks | silhouette coverage error: nearest / alpha / masks | µs a pixel (CPU): nearest / alpha / masks |"
     )?;
-    writeln!(text, "|---|---|---|---|---|---|")?;
+    writeln!(text, "|---|---|---|---|---|---|---|")?;
     for &distance in &opts.distances {
         let camera = Camera {
             elevation_deg: opts.view.0,
@@ -149,9 +149,10 @@ pub fn run(material: &Material, opts: &Options) -> Result<String> {
         };
         writeln!(
             text,
-            "| {distance} | {across:.0} px | {} / {} | {} | {} | {} |",
+            "| {distance} | {across:.0} px | {} / {} | {:.2}% | {} | {} | {} |",
             e.covered,
             e.silhouette,
+            100.0 * e.truth_error,
             col(&|m| format!("{:.2}%", 100.0 * m.mean_color_error)),
             col(&|m| format!("{:.3}", m.coverage_error)),
             col(&|m| format!("{:.1}", 1e6 * m.seconds / touched)),

@@ -58,6 +58,9 @@ pub struct ConePixel {
     pub color: [f64; 3],
     /// The covered share of the pixel, in [0, 1].
     pub coverage: f64,
+    /// The variance of `color` as an estimate of the pixel's expectation, per channel (a
+    /// supersampled truth's `s²/n` over its rays; 0 for a cone, which is deterministic).
+    pub variance: [f64; 3],
 }
 
 /// The cone tracer's inputs.

@@ -45,6 +45,7 @@ impl ObjectTruth<'_> {
         let turn = TAU * crate::math::random::splitmix(&mut rng);
         let golden = PI * (3.0 - 5f64.sqrt());
         let mut out = ConePixel::default();
+        let mut squares = [0.0; 3];
         let mut hits = 0usize;
         for i in 0..n {
             let (r, a) = (
@@ -64,9 +65,16 @@ impl ObjectTruth<'_> {
             let l = self.lighting.facet_radiance(c, nrm, m, -d, lit);
             for k in 0..3 {
                 out.color[k] += l[k] / n as f64;
+                squares[k] += l[k] * l[k] / n as f64;
             }
         }
         out.coverage = hits as f64 / n as f64;
+        // The rays are stratified (a spiral), so s²/n overstates the noise of smooth pixels; it is
+        // the right order where a few glints carry the pixel, which is what it is for.
+        for k in 0..3 {
+            let var = (squares[k] - out.color[k] * out.color[k]).max(0.0);
+            out.variance[k] = var / (n.max(2) - 1) as f64;
+        }
         out
     }
 }

@@ -31,6 +31,10 @@ pub struct ModeErrors {
 pub struct ViewErrors {
     /// Pixels the truth covers fully.
     pub covered: usize,
+    /// The relative standard error of the truth's covered mean colour, worst channel (from each
+    /// pixel's ray variance): a mean colour error below about three of these is within the
+    /// truth's own noise.
+    pub truth_error: f64,
     /// Silhouette pixels.
     pub silhouette: usize,
     /// Per mode.
@@ -113,6 +117,12 @@ impl ObjectImages {
             }
         }
         let mean_t = (sums_t.iter().sum::<f64>() / (3.0 * covered.len().max(1) as f64)).max(1e-300);
+        let truth_error = (0..3)
+            .map(|k| {
+                let var: f64 = covered.iter().map(|&i| truth_px[i].variance[k]).sum();
+                var.sqrt() / sums_t[k].max(1e-300)
+            })
+            .fold(0.0, f64::max);
         let modes = self
             .views
             .iter()
@@ -155,6 +165,7 @@ impl ObjectImages {
             .count();
         ViewErrors {
             covered: covered.len(),
+            truth_error,
             silhouette,
             modes,
         }
@@ -278,9 +289,10 @@ mod tests {
                 let t = std::time::Instant::now();
                 let e = view_errors(truth, tracer, &camera(distance), (48, 36), 64, &MODES);
                 eprintln!(
-                    "distance {distance}: {} covered, {} silhouette pixels ({:.1} s)",
+                    "distance {distance}: {} covered, {} silhouette pixels, truth's s.e. {:.2}% ({:.1} s)",
                     e.covered,
                     e.silhouette,
+                    100.0 * e.truth_error,
                     t.elapsed().as_secs_f64()
                 );
                 let touched = (e.covered + e.silhouette).max(1) as f64;
