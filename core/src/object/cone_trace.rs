@@ -80,39 +80,84 @@ pub struct ConeTracer<'a> {
 /// crosses the field's cube: each element advances by its own diameter).
 const MAX_ELEMENTS: usize = 1 << 16;
 
+/// What a cone has covered so far: the sub-rays' mask (masks, nearest) or the opacity (alpha
+/// blending).
+#[derive(Clone, Copy, Debug, Default)]
+struct Coverage {
+    covered: u64,
+    opacity: f64,
+}
+
+impl Coverage {
+    /// Adds an element's mask; the share of the pixel it newly contributes (module docs).
+    fn add(&mut self, mask: u64, mode: Compositing) -> f64 {
+        match mode {
+            Compositing::Masks | Compositing::Nearest => {
+                let fresh = mask & !self.covered;
+                self.covered |= mask;
+                f64::from(fresh.count_ones()) / MASK_BITS as f64
+            }
+            Compositing::AlphaBlend => {
+                let a = f64::from(mask.count_ones()) / MASK_BITS as f64;
+                let w = (1.0 - self.opacity) * a;
+                self.opacity += w;
+                w
+            }
+        }
+    }
+
+    /// The covered share of the pixel.
+    fn share(&self, mode: Compositing) -> f64 {
+        match mode {
+            Compositing::AlphaBlend => self.opacity,
+            _ => f64::from(self.covered.count_ones()) / MASK_BITS as f64,
+        }
+    }
+
+    /// Whether nothing behind can show any more.
+    fn full(&self, mode: Compositing) -> bool {
+        match mode {
+            Compositing::AlphaBlend => self.opacity >= 1.0 - 1e-6,
+            _ => self.covered == u64::MAX,
+        }
+    }
+}
+
 impl ConeTracer<'_> {
+    /// The sub-rays an element of radius r covers, its sample's mean plane written in the cone's
+    /// frame (e₁, e₂ across it, d along it); all of them for nearest voxels.
+    fn element_mask(
+        &self,
+        s: &VoxelSample,
+        [e1, e2, d]: [DVec3; 3],
+        r: f64,
+        mode: Compositing,
+    ) -> u64 {
+        if mode == Compositing::Nearest {
+            return u64::MAX;
+        }
+        let n = DVec3::new(s.normal.dot(e1), s.normal.dot(e2), s.normal.dot(d));
+        let (theta, v) = element_mask_params(r, r, n, s.distance);
+        self.table.lookup(theta, v)
+    }
+
     /// The pixel of `cone` (module docs).
     pub fn trace(&self, cone: &Cone, mode: Compositing) -> ConePixel {
         let mut out = ConePixel::default();
         let (e1, e2) = cone.dir.any_orthonormal_pair();
-        let mut covered = 0u64;
-        let mut opacity = 0.0;
+        let frame = [e1, e2, cone.dir];
+        let light = self.lighting.light;
+        let mut cover = Coverage::default();
         self.march(cone, mode, |s, c, r, _level| {
-            let mask = match mode {
-                Compositing::Nearest => u64::MAX,
-                _ => {
-                    let n = DVec3::new(s.normal.dot(e1), s.normal.dot(e2), s.normal.dot(cone.dir));
-                    let (theta, v) = element_mask_params(r, r, n, s.distance);
-                    self.table.lookup(theta, v)
-                }
-            };
+            let mask = self.element_mask(s, frame, r, mode);
             if mask == 0 {
                 return false;
             }
-            let weight = match mode {
-                Compositing::Masks | Compositing::Nearest => {
-                    let fresh = mask & !covered;
-                    covered |= mask;
-                    f64::from(fresh.count_ones()) / MASK_BITS as f64
-                }
-                Compositing::AlphaBlend => {
-                    let a = f64::from(mask.count_ones()) / MASK_BITS as f64;
-                    let w = (1.0 - opacity) * a;
-                    opacity += w;
-                    w
-                }
-            };
-            if weight > 0.0 {
+            let weight = cover.add(mask, mode);
+            // An element facing away from the eye or the sun sends nothing
+            // (`element_radiance`): no shadow cone for it.
+            let lit = s.normal.dot(-cone.dir) > 0.0 && s.normal.dot(light) > 0.0;
+            if weight > 0.0 && lit {
                 let sun = if self.shadows {
                     self.sun_visibility(c - s.normal * s.distance, s.normal, r, mode)
                 } else {
@@ -123,21 +168,15 @@ impl ConeTracer<'_> {
                     out.color[k] += weight * l[k];
                 }
             }
-            match mode {
-                Compositing::AlphaBlend => opacity >= 1.0 - 1e-6,
-                _ => covered == u64::MAX,
-            }
+            cover.full(mode)
         });
-        out.coverage = match mode {
-            Compositing::AlphaBlend => opacity,
-            _ => f64::from(covered.count_ones()) / MASK_BITS as f64,
-        };
+        out.coverage = cover.share(mode);
         out
     }
 
     /// The share of the sun an element of radius r sees from c, the point of its mean plane under
-    /// its centre: a shadow cone of the same radius toward the sun, from one element length out,
-    /// composited as the view's cone is.
+    /// its centre: a shadow cone of the same radius toward the sun, from where the element clears
+    /// its own mean plane, composited as the view's cone is.
     fn sun_visibility(&self, c: DVec3, normal: DVec3, r: f64, mode: Compositing) -> f64 {
         let light = self.lighting.light;
         // Start where the element's own mean plane can no longer cover the shadow cone's disc
@@ -152,33 +191,13 @@ impl ConeTracer<'_> {
             spread: 0.0,
         };
         let (e1, e2) = light.any_orthonormal_pair();
-        let mut covered = 0u64;
-        let mut opacity = 0.0f64;
+        let frame = [e1, e2, light];
+        let mut cover = Coverage::default();
         self.march(&shadow, mode, |s, _c, rr, _l| {
-            let mask = match mode {
-                Compositing::Nearest => u64::MAX,
-                _ => {
-                    let n = DVec3::new(s.normal.dot(e1), s.normal.dot(e2), s.normal.dot(light));
-                    let (theta, v) = element_mask_params(rr, rr, n, s.distance);
-                    self.table.lookup(theta, v)
-                }
-            };
-            match mode {
-                Compositing::AlphaBlend => {
-                    let a = f64::from(mask.count_ones()) / MASK_BITS as f64;
-                    opacity += (1.0 - opacity) * a;
-                    opacity >= 1.0 - 1e-6
-                }
-                _ => {
-                    covered |= mask;
-                    covered == u64::MAX
-                }
-            }
+            cover.add(self.element_mask(s, frame, rr, mode), mode);
+            cover.full(mode)
         });
-        match mode {
-            Compositing::AlphaBlend => 1.0 - opacity,
-            _ => 1.0 - f64::from(covered.count_ones()) / MASK_BITS as f64,
-        }
+        1.0 - cover.share(mode)
     }
 
     /// Steps the elements of `cone` through the field's cube, calling `visit(sample, centre,

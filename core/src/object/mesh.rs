@@ -252,14 +252,10 @@ impl TriMesh {
         let mut best = (p, DVec3::Z, f64::INFINITY);
         let mut stack = vec![0u32];
         while let Some(n) = stack.pop() {
-            let node = &self.nodes[n as usize];
-            let d = (node.lo - p)
-                .max(p - node.hi)
-                .max(DVec3::ZERO)
-                .length_squared();
-            if d >= best.2 {
+            if self.box_distance(n, p) >= best.2 {
                 continue;
             }
+            let node = &self.nodes[n as usize];
             if node.count == 0 {
                 let (l, r) = (node.start, node.start + 1);
                 // Nearer child last, so it is popped first.
@@ -292,6 +288,7 @@ impl TriMesh {
         best
     }
 
+    /// The squared distance from p to node n's box (0 inside).
     fn box_distance(&self, n: u32, p: DVec3) -> f64 {
         let node = &self.nodes[n as usize];
         (node.lo - p)
