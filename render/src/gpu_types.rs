@@ -342,6 +342,50 @@ gpu_struct! {
     }
 }
 
+gpu_struct! {
+    /// The object view's parameters (binding 4, `object` in WGSL; `render/src/object/`): the camera
+    /// as an eye and the unnormalised ray direction's affine map from pixel coordinates (core's
+    /// `Camera::raw_dir`), the sun, the octree's extent and hash, the compositing mode.
+    ObjectParams as "ObjectParams" {
+        /// The eye (world, the object's frame).
+        eye: [f32; 3] => "vec3<f32>",
+        /// Half the side of the octree's root cube, centred at the origin.
+        half: f32 => "f32",
+        /// Unnormalised ray direction at pixel coordinates (0, 0).
+        dir00: [f32; 3] => "vec3<f32>",
+        /// The cone's spread: the pixel's angular radius (core's `pixel_cone`).
+        spread: f32 => "f32",
+        /// Change of the unnormalised direction per pixel in x.
+        step_x: [f32; 3] => "vec3<f32>",
+        /// Image width, pixels.
+        width: u32 => "u32",
+        /// Change of the unnormalised direction per pixel in y.
+        step_y: [f32; 3] => "vec3<f32>",
+        /// Image height, pixels.
+        height: u32 => "u32",
+        /// Unit direction toward the sun.
+        light: [f32; 3] => "vec3<f32>",
+        /// The sun's strength.
+        sun: f32 => "f32",
+        /// The octree's finest level.
+        depth: u32 => "u32",
+        /// Hash table slots minus one (a power of two minus one).
+        slot_mask: u32 => "u32",
+        /// Compositing (`MODE_MASKS` 0, `MODE_ALPHA_BLEND` 1, `MODE_NEAREST` 2).
+        mode: u32 => "u32",
+        /// 1 when shadow cones are traced.
+        shadows: u32 => "u32",
+        /// 2 (note_budget's unfoldable count).
+        two: u32 => "u32",
+        /// Padding to 16 bytes.
+        pad0: u32 => "u32",
+        /// Padding.
+        pad1: u32 => "u32",
+        /// Padding.
+        pad2: u32 => "u32",
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -13,6 +13,7 @@ pub mod export;
 pub mod gpu;
 pub mod gpu_codes;
 pub mod gpu_types;
+pub mod object;
 pub mod renderer;
 pub mod shaders;
 pub mod specialize;

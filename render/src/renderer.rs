@@ -298,12 +298,12 @@ fn readable_storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buff
 }
 
 /// The first `bytes` of `src` as u32 words (waits for the GPU).
-fn read_words(
-    renderer: &Renderer,
+pub(crate) fn read_words(
+    ctx: &GpuContext,
     src: &wgpu::Buffer,
     bytes: u64,
 ) -> Result<Vec<u32>, RenderError> {
-    let device = &renderer.ctx.device;
+    let device = &ctx.device;
     let readback = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("readback"),
         size: bytes,
@@ -314,19 +314,17 @@ fn read_words(
         label: Some("readback"),
     });
     enc.copy_buffer_to_buffer(src, 0, &readback, 0, bytes);
-    renderer.ctx.queue.submit([enc.finish()]);
-    map_words(renderer, &readback)
+    ctx.queue.submit([enc.finish()]);
+    map_words(ctx, &readback)
 }
 
-fn map_words(renderer: &Renderer, readback: &wgpu::Buffer) -> Result<Vec<u32>, RenderError> {
+fn map_words(ctx: &GpuContext, readback: &wgpu::Buffer) -> Result<Vec<u32>, RenderError> {
     let slice = readback.slice(..);
     let (tx, rx) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
     });
-    renderer
-        .ctx
-        .device
+    ctx.device
         .poll(wgpu::PollType::wait_indefinitely())
         .map_err(|e| RenderError::Readback(e.to_string()))?;
     match rx.recv() {
@@ -422,7 +420,7 @@ impl ViewTarget {
     /// of its values are unreliable. Real GPUs have no such cap: 0 there, bar a march that ran out
     /// of its 20000 steps.
     pub fn cut_count(&self, renderer: &Renderer) -> Result<u32, RenderError> {
-        let words = read_words(renderer, &self.cut, 16)?;
+        let words = read_words(&renderer.ctx, &self.cut, 16)?;
         Ok(words.first().copied().unwrap_or(0))
     }
 
@@ -433,7 +431,7 @@ impl ViewTarget {
     /// counts). Row-major; rays traced again after a loop cut are not counted.
     pub fn read_work(&self, renderer: &Renderer) -> Result<Vec<u32>, RenderError> {
         let n = (self.width as usize) * (self.height as usize);
-        let mut words = read_words(renderer, &self.work, (n as u64 * 4).max(16))?;
+        let mut words = read_words(&renderer.ctx, &self.work, (n as u64 * 4).max(16))?;
         words.truncate(n);
         Ok(words)
     }
@@ -493,7 +491,7 @@ impl ViewTarget {
         buffer: &wgpu::Buffer,
     ) -> Result<Vec<[f32; 4]>, RenderError> {
         let size = u64::from(self.width) * u64::from(self.height) * BYTES_PER_PIXEL;
-        let words = read_words(renderer, buffer, size)?;
+        let words = read_words(&renderer.ctx, buffer, size)?;
         let floats: &[f32] = bytemuck::cast_slice(&words);
         Ok(floats
             .chunks_exact(4)

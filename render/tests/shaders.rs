@@ -3,7 +3,7 @@
 
 use lodestone_core::material::features::FeatureSet;
 use lodestone_core::math::{special, special_f32};
-use lodestone_render::gpu_types::{GpuStruct, MaterialParams, ViewParams};
+use lodestone_render::gpu_types::{GpuStruct, MaterialParams, ObjectParams, ViewParams};
 use lodestone_render::{compute::eval_unary, shaders};
 
 /// Parse and validate a file together with the files it needs.
@@ -162,6 +162,15 @@ const MIRRORS: &[(&str, &str, &str, &str)] = &[
     ("eval/pixel.wgsl", "analytic_pixel", "eval/pixel.rs", "pixel_in_frame"),
     ("view.wgsl", "raw_dir", "scene/camera.rs", "raw_dir"),
     ("view.wgsl", "plane_footprint", "scene/camera.rs", "plane_footprint"),
+    ("object/coverage_mask.wgsl", "mask_lookup", "object/coverage_mask.rs", "lookup"),
+    ("object/voxel_field.wgsl", "voxel_sample", "object/voxel_field.rs", "sample"),
+    ("object/voxel_field.wgsl", "mix_samples", "object/voxel_field.rs", "mix"),
+    ("object/cone_trace.wgsl", "coverage_add", "object/cone_trace.rs", "add"),
+    ("object/cone_trace.wgsl", "coverage_share", "object/cone_trace.rs", "share"),
+    ("object/cone_trace.wgsl", "coverage_full", "object/cone_trace.rs", "full"),
+    ("object/cone_trace.wgsl", "march_start", "object/cone_trace.rs", "march"),
+    ("object/cone_trace.wgsl", "march_next", "object/cone_trace.rs", "march"),
+    ("object/shading.wgsl", "mean_attribute", "microfacet/attribute.rs", "mean_attribute"),
 ];
 
 /// WGSL functions with no core counterpart, and why.
@@ -199,6 +208,15 @@ const GPU_ONLY: &[(&str, &str, &str)] = &[
     ("math/special.wgsl", "erf_series_term", "one term of erf_series_sum (its loop body, eight per iteration)"),
     ("math/special.wgsl", "cf_step", "one level of cf_tail (its loop body, eight per iteration)"),
     ("bindings.wgsl", "note_work", "adds to a truth ray's work (its cost, for cost-aware adaptive plans)"),
+    ("object/voxel_field.wgsl", "orthonormal_pair", "glam's DVec3::any_orthonormal_pair, which core calls"),
+    ("object/voxel_field.wgsl", "voxel_at", "unpacks voxel i's words (render/src/object/voxel_store.rs)"),
+    ("object/voxel_field.wgsl", "slot_hash", "the hash of a voxel key (voxel_store.rs slot_hash; core uses a HashMap)"),
+    ("object/voxel_field.wgsl", "find_voxel", "probes the hash table for a voxel (voxel_store.rs GpuVoxels::find)"),
+    ("object/voxel_field.wgsl", "voxel_centre", "a voxel's centre, which its stored plane offset is relative to"),
+    ("object/voxel_field.wgsl", "voxel_corner", "one corner of sample_level (its loop body, written out eight times)"),
+    ("object/shading.wgsl", "object_local", "a vector in the element's frame (shading.rs local)"),
+    ("object_view.wgsl", "object_two", "2, as a value the shader compiler cannot fold (note_budget)"),
+    ("object_view.wgsl", "object_main", "the compute entry point"),
 ];
 
 /// Functions defined at module scope of a WGSL source.
@@ -285,6 +303,7 @@ fn check_layout<T: GpuStruct>(module: &naga::Module) {
 fn gpu_params_match_the_wgsl_layout() {
     check_layout::<MaterialParams>(&module_for("material", shaders::material()));
     check_layout::<ViewParams>(&module_for("view", shaders::VIEW));
+    check_layout::<ObjectParams>(&module_for("object", shaders::object()));
 }
 
 fn inputs(lo: f32, hi: f32, n: usize, extremes: &[f32]) -> Vec<f32> {

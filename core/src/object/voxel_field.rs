@@ -48,13 +48,13 @@ pub struct VoxelField {
 }
 
 /// The world-space tensor `Σ σ_ij t_i t_jᵀ` of a slope covariance written in the frame (t₁, t₂).
-fn tensor([t1, t2]: [DVec3; 2], c: &SlopeCov) -> DMat3 {
+pub fn tensor([t1, t2]: [DVec3; 2], c: &SlopeCov) -> DMat3 {
     let o = |a: DVec3, b: DVec3| DMat3::from_cols(a * b.x, a * b.y, a * b.z);
     o(t1, t1) * c.xx + o(t2, t2) * c.yy + (o(t1, t2) + o(t2, t1)) * c.xy
 }
 
 /// A tensor's covariance in the frame (t₁, t₂) (variances floored at 0).
-fn in_frame(t1: DVec3, t2: DVec3, s: &DMat3) -> SlopeCov {
+pub fn in_frame(t1: DVec3, t2: DVec3, s: &DMat3) -> SlopeCov {
     SlopeCov {
         xx: t1.dot(*s * t1).max(0.0),
         yy: t2.dot(*s * t2).max(0.0),

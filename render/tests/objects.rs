@@ -1,0 +1,123 @@
+//! The object view's WGSL cone tracer against core's (#19, [HN12 Alg. 1]): the same octree, as the
+//! GPU stores it (f16 descriptors decoded back for core), traced by both over every pixel of small
+//! images of a displaced sphere, with masks, alpha blending and nearest voxels, shadow cones on, from
+//! afar, at middle distance and filling the view. f32 against f64: a sub-ray whose sample lies on an
+//! element's edge can fall either side, so pixels are compared in bulk (the share within a tight
+//! tolerance, the mean over the image) and no pixel may be off by more than a few sub-rays' worth.
+
+use lodestone_core::eval::Evaluator;
+use lodestone_core::material::Material;
+use lodestone_core::object::base_shape::BaseShape;
+use lodestone_core::object::cone_trace::{Compositing, ConeTracer};
+use lodestone_core::object::coverage_mask::MaskTable;
+use lodestone_core::object::displaced::DisplacedObject;
+use lodestone_core::object::object_truth::pixel_cone;
+use lodestone_core::object::octree::VoxelOctree;
+use lodestone_core::object::shading::ObjectLighting;
+use lodestone_core::object::voxel_field::VoxelField;
+use lodestone_core::scene::camera::Camera;
+use lodestone_core::scene::direction::direction;
+use lodestone_render::object::object_view::{ObjectShot, ObjectView};
+use lodestone_render::object::voxel_store::GpuVoxels;
+
+fn camera(distance: f64) -> Camera {
+    Camera {
+        elevation_deg: 60.0,
+        azimuth_deg: 30.0,
+        distance,
+        target: [0.0, 0.0],
+        fov_deg: 30.0,
+    }
+}
+
+#[test]
+fn cone_traced_pixels_match_core() {
+    let Some(ctx) = lodestone_tests::gpu("the object view test") else {
+        return;
+    };
+    let material = Material::default();
+    let ev = Evaluator::new(&material).unwrap();
+    let object = DisplacedObject::new(&material, BaseShape::Sphere { radius: 1.0 }).unwrap();
+    let tree = VoxelOctree::of_object(&object, |f| ev.color_at(f), 5, 4.0, 1);
+    let voxels = GpuVoxels::encode(&VoxelField::new(&tree));
+    let field = voxels.decode();
+    let table = MaskTable::new();
+    let lighting = ObjectLighting {
+        light: direction(37f64.to_radians(), (-37f64).to_radians()),
+        sun: material.lighting.sun,
+        brdf: material.brdf.clone(),
+        correlation: material.filtering.correlation,
+    };
+    let view = ObjectView::new(&ctx);
+    let octree = view.upload(&ctx, &voxels).unwrap();
+    let (w, h) = (32u32, 24u32);
+    for distance in [8.0, 4.0, 2.2] {
+        let cam = camera(distance);
+        for mode in [
+            Compositing::Masks,
+            Compositing::AlphaBlend,
+            Compositing::Nearest,
+        ] {
+            let tracer = ConeTracer {
+                field: &field,
+                table: &table,
+                lighting: &lighting,
+                shadows: true,
+            };
+            let shot = ObjectShot {
+                camera: &cam,
+                lighting: &lighting,
+                mode,
+                shadows: true,
+                size: (w, h),
+            };
+            let gpu = view.render(&ctx, &octree, &shot).unwrap();
+            assert_eq!(gpu.cut, 0, "{mode:?} at {distance}: the adapter cut loops");
+            let (mut close, mut worst, mut sum_gpu, mut sum_cpu, mut covered) =
+                (0usize, 0.0f64, 0.0, 0.0, 0usize);
+            let mut worst_cover = 0.0f64;
+            for y in 0..h {
+                for x in 0..w {
+                    let c = tracer.trace(
+                        &pixel_cone(&cam, f64::from(x) + 0.5, f64::from(y) + 0.5, w, h),
+                        mode,
+                    );
+                    let g = gpu.pixels[(y * w + x) as usize];
+                    let d = (0..3)
+                        .map(|k| (f64::from(g[k]) - c.color[k]).abs())
+                        .fold(0.0, f64::max);
+                    let dc = (f64::from(g[3]) - c.coverage).abs();
+                    worst = worst.max(d);
+                    worst_cover = worst_cover.max(dc);
+                    if d <= 0.01 && dc <= 2.5 / 64.0 {
+                        close += 1;
+                    }
+                    if c.coverage > 0.0 {
+                        covered += 1;
+                    }
+                    sum_gpu += f64::from(g[0] + g[1] + g[2]);
+                    sum_cpu += c.color.iter().sum::<f64>();
+                }
+            }
+            let n = (w * h) as usize;
+            let mean = (sum_gpu - sum_cpu).abs() / sum_cpu.max(1e-9);
+            eprintln!(
+                "{mode:?} d {distance}: {covered} covered, {close}/{n} close, worst colour {worst:.4}, worst coverage {worst_cover:.3}, image mean {:.3}%",
+                100.0 * mean
+            );
+            assert!(
+                covered > 30,
+                "{mode:?} at {distance}: the sphere is in view"
+            );
+            assert!(
+                close * 100 >= n * 97,
+                "{mode:?} at {distance}: {close} of {n}"
+            );
+            assert!(mean < 0.005, "{mode:?} at {distance}: image mean {mean}");
+            assert!(
+                worst < 0.25 && worst_cover <= 0.2,
+                "{mode:?} at {distance}: {worst} {worst_cover}"
+            );
+        }
+    }
+}
