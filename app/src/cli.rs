@@ -245,8 +245,9 @@ pub enum Command {
     /// A whole object (sphere, torus or a closed OBJ mesh) displaced by the preset's relief,
     /// voxelised into a sparse octree and cone traced on the CPU [HN12] beside its ray-traced
     /// ground truth, over a zoom sweep: per distance a PNG strip (nearest voxels | alpha blended |
-    /// masks | ground truth) and the colour error of covered pixels, the silhouette's coverage
-    /// error and the time per pixel. Noise drivers only; a bad mesh is exit code 2.
+    /// masks | ground truth, and with --gpu the WGSL masks) and the colour error of covered pixels,
+    /// the silhouette's coverage error and the time per pixel. Noise drivers only; a bad mesh is
+    /// exit code 2.
     Object {
         /// The base shape.
         #[arg(long, value_enum, default_value_t = ObjectShapeArg::Sphere)]
@@ -292,6 +293,10 @@ pub enum Command {
         /// to see what they carry of the error.
         #[arg(long)]
         no_shadows: bool,
+        /// Also cone trace with masks in WGSL on the GPU adapter (a fifth panel and a column of
+        /// its errors and time per pixel, measured after one warm-up frame).
+        #[arg(long)]
+        gpu: bool,
     },
     /// Error against run time: naive, view-independent, both filtered variants and ground truth at
     /// 1…256 rays against a ground-truth reference over view/light configurations and zoom levels;

@@ -24,6 +24,7 @@ mod editor;
 mod eval;
 mod inspect;
 mod object_cmd;
+mod object_scene;
 mod preset_io;
 mod render_cmd;
 mod report;
@@ -438,9 +439,11 @@ fn run(cli: Cli) -> Result<()> {
             rays,
             out,
             no_shadows,
+            gpu,
         }) => {
             let opts = object_cmd::Options {
                 shadows: !no_shadows,
+                gpu,
                 shape: object_cmd::shape(shape.name(), mesh.as_deref(), radius, minor)?,
                 depth,
                 size,

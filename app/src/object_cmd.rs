@@ -1,25 +1,21 @@
 //! `lodestone object` (#19): a whole object (sphere, torus or an OBJ mesh) displaced by the
-//! preset's relief, voxelised into the sparse octree and cone traced on the CPU (the reference the
-//! GPU views will be tested against), beside its ray-traced ground truth, over a zoom sweep. For
-//! each distance: a PNG strip (nearest voxels | alpha blended | masks, HN12 | ground truth) and a
-//! table row of the colour error of covered pixels, the silhouette's coverage error and the CPU
-//! time per pixel. Bad shapes, meshes and materials are usage errors (exit code 2).
+//! preset's relief, voxelised into the sparse octree and cone traced on the CPU (core's reference),
+//! and with `--gpu` in WGSL on the adapter, beside its ray-traced ground truth, over a zoom sweep.
+//! For each distance: a PNG strip (nearest voxels | alpha blended | masks, HN12 | ground truth |
+//! GPU masks) and a table row of the colour error of covered pixels, the silhouette's coverage
+//! error and the time per pixel. Bad shapes, meshes and materials are usage errors (exit code 2).
 
 use crate::UsageError;
+use crate::object_scene::{GpuObject, ObjectScene, lighting, masks_shot};
 use anyhow::{Context, Result};
-use lodestone_core::eval::Evaluator;
 use lodestone_core::material::Material;
 use lodestone_core::material::colormap::linear_to_srgb;
 use lodestone_core::object::base_shape::BaseShape;
 use lodestone_core::object::cone_trace::{Compositing, ConePixel, ConeTracer};
 use lodestone_core::object::coverage_mask::MaskTable;
-use lodestone_core::object::displaced::DisplacedObject;
 use lodestone_core::object::mesh::TriMesh;
 use lodestone_core::object::object_truth::ObjectTruth;
-use lodestone_core::object::octree::VoxelOctree;
-use lodestone_core::object::shading::ObjectLighting;
 use lodestone_core::object::view_error::ObjectImages;
-use lodestone_core::object::voxel_field::VoxelField;
 use lodestone_core::scene::camera::Camera;
 use lodestone_core::scene::direction::direction;
 use std::fmt::Write as _;
@@ -54,6 +50,8 @@ pub struct Options {
     pub out: Option<PathBuf>,
     /// Shadows in both the truth and the voxel views.
     pub shadows: bool,
+    /// Also the masks traced in WGSL on the GPU adapter.
+    pub gpu: bool,
 }
 
 /// The base shape named on the command line; a mesh is read and checked here.
@@ -82,39 +80,45 @@ pub fn shape(kind: &str, mesh: Option<&Path>, radius: f64, minor: f64) -> Result
 
 /// Builds the object and its octree, renders every distance, writes the strips; the table's text.
 pub fn run(material: &Material, opts: &Options) -> Result<String> {
-    let object = DisplacedObject::new(material, opts.shape.clone())
-        .map_err(|e| UsageError(format!("the object: {e}")))?;
+    let scene = ObjectScene::build(material, opts.shape.clone(), opts.depth)?;
     if let Some(out) = &opts.out {
         std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     }
-    let ev = Evaluator::new(material).context("preparing the material")?;
-    let color = |f: f64| ev.color_at(f);
-    let started = std::time::Instant::now();
-    let tree = VoxelOctree::of_object(&object, color, opts.depth, 4.0, 1);
-    let build = started.elapsed().as_secs_f64();
-    let field = VoxelField::new(&tree);
+    let color = |f: f64| scene.color(f);
+    let (object, field, build) = (&scene.object, &scene.field, scene.build_seconds);
     let table = MaskTable::new();
-    let lighting = ObjectLighting {
-        light: direction(opts.light.0.to_radians(), opts.light.1.to_radians()),
-        sun: material.lighting.sun,
-        brdf: material.brdf.clone(),
-        correlation: material.filtering.correlation,
-    };
+    let lighting = lighting(
+        material,
+        direction(opts.light.0.to_radians(), opts.light.1.to_radians()),
+    );
     let tracer = ConeTracer {
-        field: &field,
+        field,
         table: &table,
         lighting: &lighting,
         shadows: opts.shadows,
     };
     let truth = ObjectTruth {
-        object: &object,
+        object,
         lighting: &lighting,
         color: &color,
         shadows: opts.shadows,
     };
+    let gpu = if opts.gpu {
+        Some(GpuObject::new(field).context("the GPU object view")?)
+    } else {
+        None
+    };
     let mut text = String::new();
-    let bytes: usize = tree.memory().iter().map(|l| l.gpu_bytes).sum();
-    let finest = tree.memory().last().map_or(0, |l| l.voxels);
+    if let Some(g) = &gpu {
+        writeln!(
+            text,
+            "GPU: {} (octree uploaded: {:.2} MiB with its hash table)",
+            g.ctx.describe(),
+            g.octree.bytes as f64 / (1 << 20) as f64
+        )?;
+    }
+    let bytes: usize = scene.memory.iter().map(|l| l.gpu_bytes).sum();
+    let finest = scene.memory.last().map_or(0, |l| l.voxels);
     writeln!(
         text,
         "{}: {}, octree depth {} ({} voxels at the finest level, {:.2} MiB at {} bytes a voxel over all levels; built in {:.1} s)",
@@ -126,9 +130,10 @@ pub fn run(material: &Material, opts: &Options) -> Result<String> {
         lodestone_core::object::octree::GPU_BYTES_PER_VOXEL,
         build
     )?;
+    let gpu_col = if gpu.is_some() { " / masks (GPU)" } else { "" };
     writeln!(
         text,
-        "| distance | across | covered / silhouette px | truth's s.e. | mean colour error: nearest / alpha / masks | silhouette coverage error: nearest / alpha / masks | µs a pixel (CPU): nearest / alpha / masks |"
+        "| distance | across | covered / silhouette px | truth's s.e. | mean colour error: nearest / alpha / masks{gpu_col} | silhouette coverage error: nearest / alpha / masks{gpu_col} | µs a pixel: nearest / alpha / masks (CPU, one core){gpu_col} |"
     )?;
     writeln!(text, "|---|---|---|---|---|---|---|")?;
     for &distance in &opts.distances {
@@ -139,7 +144,13 @@ pub fn run(material: &Material, opts: &Options) -> Result<String> {
             target: [0.0, 0.0],
             fov_deg: 30.0,
         };
-        let images = ObjectImages::render(&truth, &tracer, &camera, opts.size, opts.rays, &MODES);
+        let mut images =
+            ObjectImages::render(&truth, &tracer, &camera, opts.size, opts.rays, &MODES);
+        if let Some(g) = &gpu {
+            let shot = masks_shot(&camera, &lighting, opts.shadows, opts.size);
+            let (px, seconds) = g.render(&shot, true)?;
+            images.views.push((Compositing::Masks, px, seconds));
+        }
         let e = images.errors();
         let pixel = 2.0 * camera.tan_half_fov() / f64::from(opts.size.1);
         let across = 2.0 * object.bounding_radius() / distance / pixel;
@@ -154,7 +165,11 @@ pub fn run(material: &Material, opts: &Options) -> Result<String> {
             e.silhouette,
             100.0 * e.truth_error,
             col(&|m| format!("{:.2}%", 100.0 * m.mean_color_error)),
-            col(&|m| format!("{:.3}", m.coverage_error)),
+            if e.silhouette == 0 {
+                "— (no silhouette in view)".to_string()
+            } else {
+                col(&|m| format!("{:.3}", m.coverage_error))
+            },
             col(&|m| format!("{:.1}", 1e6 * m.seconds / touched)),
         )?;
         if let Some(out) = &opts.out {
@@ -175,15 +190,16 @@ fn kind_name(s: &BaseShape) -> &'static str {
     }
 }
 
-/// nearest | alpha | masks | truth, side by side with 4-pixel gaps, in sRGB.
+/// nearest | alpha | masks | truth (| GPU masks), side by side with 4-pixel gaps, in sRGB.
 fn strip(images: &ObjectImages) -> image::RgbImage {
     let (w, h) = (images.width, images.height);
     let gap = 4;
-    let panels: Vec<&[ConePixel]> = images
-        .views
+    let cpu = MODES.len().min(images.views.len());
+    let panels: Vec<&[ConePixel]> = images.views[..cpu]
         .iter()
         .map(|v| v.1.as_slice())
         .chain(std::iter::once(images.truth.as_slice()))
+        .chain(images.views[cpu..].iter().map(|v| v.1.as_slice()))
         .collect();
     let mut img = image::RgbImage::from_pixel(
         panels.len() as u32 * (w + gap) - gap,

@@ -129,6 +129,8 @@ impl EditorApp {
                 ui.separator();
                 ui.checkbox(&mut self.view.show_plots, "Plots");
                 ui.checkbox(&mut self.report.open, "Error against run time report");
+                ui.checkbox(&mut self.object.open, "Object (voxel octree)")
+                    .on_hover_text("A sphere, torus or mesh displaced by the material, voxelised and cone traced [HN12]");
                 self.command_button(ui, "Sweep zoom", Command::ToggleSweep);
                 if ui.button("Reset camera").clicked() {
                     self.view.camera = ViewState::default().camera;

@@ -17,6 +17,7 @@ pub mod gradient_editor;
 pub mod history;
 pub mod inspector;
 mod menu;
+pub mod object_panel;
 pub mod plots;
 pub mod priority;
 pub mod report_panel;
@@ -158,6 +159,7 @@ pub struct EditorApp {
     view_px: [u32; 2],
     plots: AnglePlots,
     report: report_panel::ReportPanel,
+    object: object_panel::ObjectPanel,
     notice: Option<Notice>,
     pending: Option<Pending>,
     frame_times: VecDeque<f64>,
@@ -246,6 +248,7 @@ impl EditorApp {
             view_px: [0, 0],
             plots: AnglePlots::default(),
             report: report_panel::ReportPanel::default(),
+            object: object_panel::ObjectPanel::default(),
             notice,
             pending: None,
             frame_times: VecDeque::new(),
@@ -435,6 +438,11 @@ impl eframe::App for EditorApp {
             && let Some(preset) = self.resolved_now(&ctx)
         {
             self.report.start(preset, ctx.clone());
+        }
+        if self.object.ui(&ctx, &self.view) == object_panel::Action::Build
+            && let Some(preset) = self.resolved_now(&ctx)
+        {
+            self.object.build(&ctx, preset.material);
         }
         egui::Panel::top("menu").show(ui, |ui| self.menu_bar(ui));
         egui::Panel::bottom("status").show(ui, |ui| self.status_bar(ui));
