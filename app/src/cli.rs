@@ -297,6 +297,13 @@ pub enum Command {
         /// its errors and time per pixel, measured after one warm-up frame).
         #[arg(long)]
         gpu: bool,
+        /// Depth of field: the thin lens's radius (world units, 0 to 10; 0 is a pinhole), in the
+        /// truth and as wider cones [HN12 Sec. 4.1].
+        #[arg(long, default_value_t = 0.0, value_parser = lens_radius)]
+        lens: f64,
+        /// The distance in focus (world units; default: each distance, the object's centre).
+        #[arg(long, value_parser = distance)]
+        focus: Option<f64>,
     },
     /// Error against run time: naive, view-independent, both filtered variants and ground truth at
     /// 1…256 rays against a ground-truth reference over view/light configurations and zoom levels;
@@ -560,6 +567,11 @@ pub fn azimuth(s: &str) -> Result<f64, String> {
 pub fn distance(s: &str) -> Result<f64, String> {
     let (lo, hi) = crate::editor::view_state::DISTANCE_RANGE;
     number_in(s, lo, hi, "the camera distance (world units)")
+}
+
+/// A thin lens's radius: 0 (a pinhole) to 10 world units.
+pub fn lens_radius(s: &str) -> Result<f64, String> {
+    number_in(s, 0.0, 10.0, "the lens radius (world units)")
 }
 
 /// An adaptive ground truth's budget: 0 (none) to 4096 rays per pixel on average.

@@ -440,10 +440,14 @@ fn run(cli: Cli) -> Result<()> {
             out,
             no_shadows,
             gpu,
+            lens,
+            focus,
         }) => {
             let opts = object_cmd::Options {
                 shadows: !no_shadows,
                 gpu,
+                lens,
+                focus,
                 shape: object_cmd::shape(shape.name(), mesh.as_deref(), radius, minor)?,
                 depth,
                 size,

@@ -14,7 +14,7 @@ use lodestone_core::object::base_shape::BaseShape;
 use lodestone_core::object::cone_trace::{Compositing, ConePixel, ConeTracer};
 use lodestone_core::object::coverage_mask::MaskTable;
 use lodestone_core::object::mesh::TriMesh;
-use lodestone_core::object::object_truth::ObjectTruth;
+use lodestone_core::object::object_truth::{Lens, ObjectTruth};
 use lodestone_core::object::view_error::ObjectImages;
 use lodestone_core::scene::camera::Camera;
 use lodestone_core::scene::direction::direction;
@@ -52,6 +52,10 @@ pub struct Options {
     pub shadows: bool,
     /// Also the masks traced in WGSL on the GPU adapter.
     pub gpu: bool,
+    /// The thin lens's radius (0: a pinhole).
+    pub lens: f64,
+    /// The distance in focus (none: each distance's, the object's centre).
+    pub focus: Option<f64>,
 }
 
 /// The base shape named on the command line; a mesh is read and checked here.
@@ -144,10 +148,14 @@ pub fn run(material: &Material, opts: &Options) -> Result<String> {
             target: [0.0, 0.0],
             fov_deg: 30.0,
         };
+        let lens = Lens {
+            radius: opts.lens,
+            focus: opts.focus.unwrap_or(distance),
+        };
         let mut images =
-            ObjectImages::render(&truth, &tracer, &camera, opts.size, opts.rays, &MODES);
+            ObjectImages::render(&truth, &tracer, &camera, opts.size, opts.rays, &MODES, lens);
         if let Some(g) = &gpu {
-            let shot = masks_shot(&camera, &lighting, opts.shadows, opts.size);
+            let shot = masks_shot(&camera, &lighting, opts.shadows, opts.size, lens);
             let (px, seconds) = g.render(&shot, true)?;
             images.views.push((Compositing::Masks, px, seconds));
         }

@@ -10,6 +10,7 @@ use lodestone_core::material::Material;
 use lodestone_core::object::base_shape::BaseShape;
 use lodestone_core::object::cone_trace::{Compositing, ConePixel};
 use lodestone_core::object::displaced::DisplacedObject;
+use lodestone_core::object::object_truth::Lens;
 use lodestone_core::object::octree::{LevelMemory, VoxelOctree};
 use lodestone_core::object::shading::ObjectLighting;
 use lodestone_core::object::voxel_field::VoxelField;
@@ -122,12 +123,13 @@ impl GpuObject {
     }
 }
 
-/// The shot of masks (ours) for `camera` and `lighting`.
+/// The shot of masks (ours) for `camera` and `lighting` through `lens`.
 pub fn masks_shot<'a>(
     camera: &'a Camera,
     lighting: &'a ObjectLighting,
     shadows: bool,
     size: (u32, u32),
+    lens: Lens,
 ) -> ObjectShot<'a> {
     ObjectShot {
         camera,
@@ -135,5 +137,6 @@ pub fn masks_shot<'a>(
         mode: Compositing::Masks,
         shadows,
         size,
+        lens,
     }
 }

@@ -1296,6 +1296,8 @@ fn object_refuses_bad_input_and_renders_a_small_sweep() {
             ],
             "minor radius",
         ),
+        (vec!["object", "--lens=-1"], "lens radius"),
+        (vec!["object", "--lens", "0.1", "--focus", "0"], "distance"),
     ] {
         let out = lodestone(&args);
         let err = String::from_utf8_lossy(&out.stderr);
@@ -1333,5 +1335,56 @@ fn object_refuses_bad_input_and_renders_a_small_sweep() {
     );
     let png = image::open(strips.join("object-d6.png")).unwrap();
     assert_eq!((png.width(), png.height()), (4 * 16 + 3 * 4, 12));
+    // Through a lens, with the WGSL masks beside the CPU's: a fifth panel and column, the same
+    // errors up to the f16 storage (the GPU test holds the two equal over the same stored field).
+    let out = lodestone(&[
+        "object",
+        "--size",
+        "16x12",
+        "--distances",
+        "6",
+        "--depth",
+        "4",
+        "--rays",
+        "4",
+        "--lens",
+        "0.2",
+        "--focus",
+        "4",
+        "--gpu",
+        "--out",
+        strips.to_str().unwrap(),
+    ]);
+    if out.status.code() == Some(3) {
+        lodestone_tests::skip("object --gpu", "no adapter");
+    } else {
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(
+            text.contains("masks (GPU)") && text.contains("GPU: "),
+            "{text}"
+        );
+        let row = text.lines().find(|l| l.starts_with("| 6 |")).expect(&text);
+        let colour: Vec<&str> = row
+            .split('|')
+            .nth(5)
+            .unwrap()
+            .split('/')
+            .map(str::trim)
+            .collect();
+        assert_eq!(colour.len(), 4, "{row}");
+        let pct = |s: &str| s.trim_end_matches('%').parse::<f64>().expect(s);
+        // The GPU reads the f16-stored octree, the CPU the f64 one: within 0.1 points.
+        assert!(
+            (pct(colour[2]) - pct(colour[3])).abs() < 0.1,
+            "CPU and GPU masks: {row}"
+        );
+        let png = image::open(strips.join("object-d6.png")).unwrap();
+        assert_eq!((png.width(), png.height()), (5 * 16 + 4 * 4, 12));
+    }
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -377,12 +377,12 @@ gpu_struct! {
         shadows: u32 => "u32",
         /// 2 (note_budget's unfoldable count).
         two: u32 => "u32",
+        /// The thin lens's radius (world units; 0: a pinhole, no depth of field).
+        lens: f32 => "f32",
+        /// The distance along each pixel's axis in focus.
+        focus: f32 => "f32",
         /// Padding to 16 bytes.
         pad0: u32 => "u32",
-        /// Padding.
-        pad1: u32 => "u32",
-        /// Padding.
-        pad2: u32 => "u32",
     }
 }
 

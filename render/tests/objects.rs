@@ -1,7 +1,7 @@
 //! The object view's WGSL cone tracer against core's (#19, [HN12 Alg. 1]): the same octree, as the
 //! GPU stores it (f16 descriptors decoded back for core), traced by both over every pixel of small
 //! images of a displaced sphere, with masks, alpha blending and nearest voxels, shadow cones on, from
-//! afar, at middle distance and filling the view. f32 against f64: a sub-ray whose sample lies on an
+//! afar, at middle distance, filling the view, and through a lens (depth of field). f32 against f64: a sub-ray whose sample lies on an
 //! element's edge can fall either side, so pixels are compared in bulk (the share within a tight
 //! tolerance, the mean over the image) and no pixel may be off by more than a few sub-rays' worth.
 
@@ -11,7 +11,7 @@ use lodestone_core::object::base_shape::BaseShape;
 use lodestone_core::object::cone_trace::{Compositing, ConeTracer};
 use lodestone_core::object::coverage_mask::MaskTable;
 use lodestone_core::object::displaced::DisplacedObject;
-use lodestone_core::object::object_truth::pixel_cone;
+use lodestone_core::object::object_truth::{Lens, pixel_cone};
 use lodestone_core::object::octree::VoxelOctree;
 use lodestone_core::object::shading::ObjectLighting;
 use lodestone_core::object::voxel_field::VoxelField;
@@ -51,7 +51,19 @@ fn cone_traced_pixels_match_core() {
     let view = ObjectView::new(&ctx);
     let octree = view.upload(&ctx, &voxels).unwrap();
     let (w, h) = (32u32, 24u32);
-    for distance in [8.0, 4.0, 2.2] {
+    // The third distance through a lens (radius 0.2, focused in front of the sphere).
+    for (distance, lens) in [
+        (8.0, Lens::PINHOLE),
+        (4.0, Lens::PINHOLE),
+        (2.2, Lens::PINHOLE),
+        (
+            4.0,
+            Lens {
+                radius: 0.2,
+                focus: 2.0,
+            },
+        ),
+    ] {
         let cam = camera(distance);
         for mode in [
             Compositing::Masks,
@@ -70,6 +82,7 @@ fn cone_traced_pixels_match_core() {
                 mode,
                 shadows: true,
                 size: (w, h),
+                lens,
             };
             let gpu = view.render(&ctx, &octree, &shot).unwrap();
             assert_eq!(gpu.cut, 0, "{mode:?} at {distance}: the adapter cut loops");
@@ -79,7 +92,8 @@ fn cone_traced_pixels_match_core() {
             for y in 0..h {
                 for x in 0..w {
                     let c = tracer.trace(
-                        &pixel_cone(&cam, f64::from(x) + 0.5, f64::from(y) + 0.5, w, h),
+                        &pixel_cone(&cam, f64::from(x) + 0.5, f64::from(y) + 0.5, w, h)
+                            .with_lens(lens.radius, lens.focus),
                         mode,
                     );
                     let g = gpu.pixels[(y * w + x) as usize];

@@ -170,6 +170,7 @@ const MIRRORS: &[(&str, &str, &str, &str)] = &[
     ("object/cone_trace.wgsl", "coverage_full", "object/cone_trace.rs", "full"),
     ("object/cone_trace.wgsl", "march_start", "object/cone_trace.rs", "march"),
     ("object/cone_trace.wgsl", "march_next", "object/cone_trace.rs", "march"),
+    ("object/cone_trace.wgsl", "cone_radius", "object/cone_trace.rs", "radius"),
     ("object/shading.wgsl", "mean_attribute", "microfacet/attribute.rs", "mean_attribute"),
 ];
 

@@ -15,7 +15,7 @@ use lodestone_core::material::colormap::linear_to_srgb;
 use lodestone_core::object::base_shape::BaseShape;
 use lodestone_core::object::cone_trace::{Compositing, ConePixel, ConeTracer};
 use lodestone_core::object::coverage_mask::MaskTable;
-use lodestone_core::object::object_truth::{ObjectTruth, pixel_cone};
+use lodestone_core::object::object_truth::{Lens, ObjectTruth, pixel_cone};
 use lodestone_core::object::view_error::{ObjectImages, ViewErrors};
 use lodestone_core::scene::camera::Camera;
 use std::path::PathBuf;
@@ -61,6 +61,7 @@ struct Shot {
     light: DVec3,
     shadows: bool,
     size: (u32, u32),
+    lens: Lens,
 }
 
 enum Job {
@@ -92,6 +93,8 @@ pub struct ObjectPanel {
     distance: f64,
     shadows: bool,
     rays: u32,
+    lens: f64,
+    focus: f64,
     built: bool,
     last: Option<Shot>,
     jobs: Option<Sender<Job>>,
@@ -111,6 +114,8 @@ impl Default for ObjectPanel {
             distance: 5.0,
             shadows: true,
             rays: 32,
+            lens: 0.0,
+            focus: 4.0,
             built: false,
             last: None,
             jobs: None,
@@ -201,7 +206,7 @@ fn run(jobs: Receiver<Job>, shared: Arc<Mutex<Shared>>, repaint: impl Fn()) {
             let px = match gpu {
                 Some(g) => g
                     .render(
-                        &masks_shot(&shot.camera, &light, shot.shadows, shot.size),
+                        &masks_shot(&shot.camera, &light, shot.shadows, shot.size, shot.lens),
                         false,
                     )
                     .map(|(p, _)| p)
@@ -246,6 +251,7 @@ fn run(jobs: Receiver<Job>, shared: Arc<Mutex<Shared>>, repaint: impl Fn()) {
                 shot.size,
                 rays as usize,
                 &modes,
+                shot.lens,
             );
             let errors = images.errors();
             let names = ["nearest voxels", "alpha blended", "ours (masks)"];
@@ -288,7 +294,8 @@ fn cpu_masks(
                 f64::from(i / w) + 0.5,
                 w,
                 h,
-            );
+            )
+            .with_lens(shot.lens.radius, shot.lens.focus);
             tracer.trace(&cone, Compositing::Masks)
         })
         .collect()
@@ -384,6 +391,10 @@ impl ObjectPanel {
             light: view.light(),
             shadows: self.shadows,
             size: SIZE,
+            lens: Lens {
+                radius: self.lens,
+                focus: self.focus,
+            },
         }
     }
 
@@ -440,6 +451,10 @@ impl ObjectPanel {
                     .text("distance"),
             )
             .on_hover_text("Dolly: the camera's distance from the object's centre (the cone's level follows its radius, HN12 Alg. 1)");
+            ui.add(egui::Slider::new(&mut self.lens, 0.0..=0.5).text("lens radius"))
+                .on_hover_text("Depth of field: the thin lens's radius; the cones widen by its circle of confusion, lens·|1 − t/focus| [HN12 Sec. 4.1, Fig. 1d]");
+            ui.add(egui::Slider::new(&mut self.focus, 0.5..=40.0).logarithmic(true).text("focus"))
+                .on_hover_text("The distance in focus along each pixel's axis (world units)");
             ui.checkbox(&mut self.shadows, "shadows")
                 .on_hover_text("Shadow cones toward the sun (and shadow rays in the ground truth)");
             ui.add(egui::DragValue::new(&mut self.rays).range(4..=512).prefix("truth rays "))

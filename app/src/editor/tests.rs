@@ -706,7 +706,7 @@ fn object_window_builds_renders_and_compares() {
 #[test]
 #[ignore = "regenerates screenshots/app/object-window-d*.png (a few minutes); run explicitly"]
 fn regenerate_object_screenshots() {
-    let mut h = harness(1600.0, 900.0, DeviceSource::Unavailable);
+    let mut h = harness(1600.0, 900.0, DeviceSource::Headless);
     h.state_mut().object.open = true;
     h.state_mut().object.set_budget(7, 64, 8.0);
     h.state_mut().view.camera.elevation_deg = 60.0;

@@ -45,10 +45,40 @@ pub struct Cone {
     pub origin: DVec3,
     /// Unit axis.
     pub dir: DVec3,
-    /// Radius at the apex (the lens radius; 0 for a pinhole).
+    /// Radius at the apex (0 for a pixel's cone; a shadow cone's starting radius).
     pub radius0: f64,
     /// Radius gained per unit distance (the pixel's angular radius).
     pub spread: f64,
+    /// The thin lens's radius (world units; 0 for a pinhole: no depth of field).
+    pub lens: f64,
+    /// The distance along the axis that is in focus (used when `lens` > 0; must be > 0).
+    pub focus: f64,
+}
+
+impl Cone {
+    /// The cone's radius at distance t along its axis [HN12 Sec. 4.1, Fig. 1d: depth of field by
+    /// wider cones]: the pixel's footprint `radius0 + spread·t` and the lens's circle of confusion
+    /// `lens·|1 − t/focus|` (a disc of the lens seen through the focus point) combined as independent
+    /// discs, whose second moments add: `√(a² + b²)`. A pinhole (lens 0) gives the footprint alone;
+    /// a focus of 0 or less is taken as no lens.
+    pub fn radius(&self, t: f64) -> f64 {
+        let a = self.radius0 + self.spread * t;
+        if !(self.lens > 0.0 && self.focus > 0.0) {
+            return a;
+        }
+        let b = self.lens * (1.0 - t / self.focus);
+        (a * a + b * b).sqrt()
+    }
+
+    /// The cone with a thin lens of radius `lens` focused at distance `focus`.
+    #[must_use]
+    pub fn with_lens(self, lens: f64, focus: f64) -> Self {
+        Self {
+            lens: lens.max(0.0),
+            focus,
+            ..self
+        }
+    }
 }
 
 /// What a cone returns.
@@ -189,6 +219,8 @@ impl ConeTracer<'_> {
             dir: light,
             radius0: r,
             spread: 0.0,
+            lens: 0.0,
+            focus: 1.0,
         };
         let (e1, e2) = light.any_orthonormal_pair();
         let frame = [e1, e2, light];
@@ -218,7 +250,7 @@ impl ConeTracer<'_> {
             if t >= t1 {
                 return;
             }
-            let r = (cone.radius0 + cone.spread * t).max(1e-9 * f.half);
+            let r = cone.radius(t).max(1e-9 * f.half);
             let c = cone.origin + cone.dir * (t + r);
             let level = (f.half / r).log2().clamp(0.0, depth);
             let sample = match mode {

@@ -7,6 +7,7 @@ pub mod base_shape;
 pub mod cone_trace;
 pub mod coverage_mask;
 pub mod displaced;
+pub mod dolly;
 pub mod icosphere;
 pub mod mesh;
 pub mod object_truth;

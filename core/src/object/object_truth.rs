@@ -36,13 +36,17 @@ impl std::fmt::Debug for ObjectTruth<'_> {
 }
 
 impl ObjectTruth<'_> {
-    /// The pixel of `cone` with `rays` rays (at least 1); `seed` turns the spiral. A pinhole
-    /// cone (radius0 = 0) only: the lens of depth of field is the cone tracer's.
+    /// The pixel of `cone` with `rays` rays (at least 1); `seed` turns the spiral. The cone's apex
+    /// radius must be 0 (a pixel's cone). With a lens ([`Cone::lens`] > 0) each ray leaves a point
+    /// of the lens disc (a second low-discrepancy sequence, R2, turned by the seed) toward the point
+    /// its pixel direction meets at the focus distance along the axis: a thin lens whose plane of
+    /// focus is perpendicular to the pixel's axis (the cone tracer's circle of confusion).
     pub fn pixel(&self, cone: &Cone, rays: usize, seed: u64) -> ConePixel {
         let n = rays.max(1);
         let (e1, e2) = cone.dir.any_orthonormal_pair();
         let mut rng = seed;
         let turn = TAU * crate::math::random::splitmix(&mut rng);
+        let lens_turn = crate::math::random::splitmix(&mut rng);
         let golden = PI * (3.0 - 5f64.sqrt());
         let mut out = ConePixel::default();
         let mut squares = [0.0; 3];
@@ -52,9 +56,19 @@ impl ObjectTruth<'_> {
                 ((i as f64 + 0.5) / n as f64).sqrt(),
                 turn + golden * i as f64,
             );
-            let d =
+            let dp =
                 (cone.dir + (e1 * (r * a.cos()) + e2 * (r * a.sin())) * cone.spread).normalize();
-            let Some(hit) = self.object.trace(cone.origin, d) else {
+            let (origin, d) = if cone.lens > 0.0 && cone.focus > 0.0 {
+                let u = (0.5 + lens_turn + i as f64 * 0.754_877_666_246_692_8).fract();
+                let v = (0.5 + lens_turn + i as f64 * 0.569_840_290_998_053_2).fract();
+                let (rl, al) = (cone.lens * u.sqrt(), TAU * v);
+                let o = cone.origin + (e1 * al.cos() + e2 * al.sin()) * rl;
+                let q = cone.origin + dp * (cone.focus / dp.dot(cone.dir));
+                (o, (q - o).normalize())
+            } else {
+                (cone.origin, dp)
+            };
+            let Some(hit) = self.object.trace(origin, d) else {
                 continue;
             };
             hits += 1;
@@ -97,5 +111,25 @@ pub fn pixel_cone(
         dir: ray.dir,
         radius0: 0.0,
         spread: pixel / PI.sqrt(),
+        lens: 0.0,
+        focus: 1.0,
     }
+}
+
+/// A thin lens: its radius (world units; 0 for a pinhole) and the distance along each pixel's axis
+/// that is in focus (#19, depth of field by wider cones [HN12 Sec. 4.1, Fig. 1d]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lens {
+    /// Lens radius, world units (0: a pinhole).
+    pub radius: f64,
+    /// Distance in focus, world units (> 0).
+    pub focus: f64,
+}
+
+impl Lens {
+    /// No depth of field.
+    pub const PINHOLE: Lens = Lens {
+        radius: 0.0,
+        focus: 1.0,
+    };
 }

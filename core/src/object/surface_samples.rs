@@ -8,7 +8,8 @@
 //! Its area is the base cell's times the displaced surface's area element, `|∇F|/(m·∇F)` (the
 //! height-field element `√(1 + |∇h|²)` for a displacement along m; the base's own curvature
 //! factor `1 + κh` is left out: O(σ_h/R), 2% at the relief's limit of a quarter radius).
-//! Cells whose trace finds nothing (none on a valid object) are dropped.
+//! Cells whose trace finds nothing (none on a valid object) are dropped. The traces run in parallel
+//! (rayon); the samples keep the base points' order.
 
 use crate::object::displaced::DisplacedObject;
 use glam::DVec3;
@@ -31,10 +32,11 @@ pub struct SurfaceSample {
 impl DisplacedObject {
     /// `n × n` samples of the surface (module docs), jittered with `seed`.
     pub fn surface_samples(&self, n: usize, seed: u64) -> Vec<SurfaceSample> {
+        use rayon::prelude::*;
         let reach = self.surface.h_max + 1e-3 * self.shape.bounding_radius();
         self.shape
             .surface_points(n, seed)
-            .into_iter()
+            .into_par_iter()
             .filter_map(|(b, base_area)| {
                 let m = self.shape.normal(b);
                 let hit = self.trace(b + m * reach, -m)?;

@@ -8,7 +8,7 @@
 //!   does not): the mean absolute difference of the covered share.
 
 use crate::object::cone_trace::{Compositing, ConePixel, ConeTracer};
-use crate::object::object_truth::{ObjectTruth, pixel_cone};
+use crate::object::object_truth::{Lens, ObjectTruth, pixel_cone};
 use crate::scene::camera::Camera;
 
 /// One mode's errors over an image.
@@ -56,7 +56,7 @@ pub struct ObjectImages {
 
 impl ObjectImages {
     /// Renders a `width × height` image of `camera` with the truth (`rays` a pixel) and each of
-    /// `modes`, rows in parallel.
+    /// `modes`, rows in parallel, through `lens` (depth of field in the truth and the cones alike).
     pub fn render(
         truth: &ObjectTruth,
         tracer: &ConeTracer,
@@ -64,6 +64,7 @@ impl ObjectImages {
         (width, height): (u32, u32),
         rays: usize,
         modes: &[Compositing],
+        lens: Lens,
     ) -> Self {
         use rayon::prelude::*;
         // Per row: the truth's pixels, each mode's pixels, each mode's seconds.
@@ -75,7 +76,8 @@ impl ObjectImages {
                 let mut v_rows = vec![Vec::with_capacity(width as usize); modes.len()];
                 let mut secs = vec![0.0; modes.len()];
                 for x in 0..width {
-                    let cone = pixel_cone(camera, x as f64 + 0.5, y as f64 + 0.5, width, height);
+                    let cone = pixel_cone(camera, x as f64 + 0.5, y as f64 + 0.5, width, height)
+                        .with_lens(lens.radius, lens.focus);
                     t_row.push(truth.pixel(&cone, rays, u64::from(y * width + x)));
                     for (i, m) in modes.iter().enumerate() {
                         let t = std::time::Instant::now();
@@ -181,7 +183,7 @@ pub fn view_errors(
     rays: usize,
     modes: &[Compositing],
 ) -> ViewErrors {
-    ObjectImages::render(truth, tracer, camera, size, rays, modes).errors()
+    ObjectImages::render(truth, tracer, camera, size, rays, modes, Lens::PINHOLE).errors()
 }
 
 #[cfg(test)]
@@ -264,6 +266,40 @@ mod tests {
             assert!(masks.coverage_error * 3.0 < alpha.coverage_error, "{e:?}");
             assert!(masks.coverage_error * 3.0 < nearest.coverage_error, "{e:?}");
             assert!(masks.mean_color_error < 0.04, "{e:?}");
+        });
+    }
+
+    /// Depth of field (a lens of radius 0.25 focused at distance 2, the sphere's front at 3, so a
+    /// circle of confusion of about two pixels): the truth's silhouette widens (more partially
+    /// covered pixels than through a pinhole: measured 141 against 51) and the wider cones follow
+    /// it, the masks' coverage error 0.10 (alpha blending 0.24; through the pinhole 0.05 and 0.25),
+    /// the covered pixels' colour 5.7% off (pinhole 1.8%: the wide cones read level 3 of this
+    /// depth-5 octree, whose voxels hold a curved piece of the sphere as one plane).
+    #[test]
+    fn wider_cones_follow_the_lens() {
+        with_scene(5, |_, truth, tracer| {
+            let cam = camera(4.0);
+            let modes = [Compositing::AlphaBlend, Compositing::Masks];
+            let lens = Lens {
+                radius: 0.25,
+                focus: 2.0,
+            };
+            let sharp =
+                ObjectImages::render(truth, tracer, &cam, (20, 15), 32, &modes, Lens::PINHOLE)
+                    .errors();
+            let blurred =
+                ObjectImages::render(truth, tracer, &cam, (20, 15), 32, &modes, lens).errors();
+            eprintln!("pinhole {sharp:?}\nlens {blurred:?}");
+            let [alpha, masks] = [0, 1].map(|i| blurred.modes[i]);
+            assert!(
+                blurred.silhouette as f64 > 1.3 * sharp.silhouette as f64,
+                "{} {}",
+                blurred.silhouette,
+                sharp.silhouette
+            );
+            assert!(masks.coverage_error < alpha.coverage_error, "{blurred:?}");
+            assert!(masks.coverage_error < 0.12, "{blurred:?}");
+            assert!(masks.mean_color_error < 0.07, "{blurred:?}");
         });
     }
 

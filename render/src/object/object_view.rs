@@ -20,6 +20,7 @@ use lodestone_core::material::features::{Feature, FeatureSet};
 use lodestone_core::microfacet::masking_shadowing::Correlation;
 use lodestone_core::object::cone_trace::Compositing;
 use lodestone_core::object::coverage_mask::MaskTable;
+use lodestone_core::object::object_truth::Lens;
 use lodestone_core::object::shading::ObjectLighting;
 use lodestone_core::scene::camera::Camera;
 use std::f64::consts::PI;
@@ -76,6 +77,8 @@ pub struct ObjectShot<'a> {
     pub shadows: bool,
     /// Image size, pixels.
     pub size: (u32, u32),
+    /// The thin lens (depth of field; [`Lens::PINHOLE`] for none).
+    pub lens: Lens,
 }
 
 /// A rendered object image: linear RGB and coverage per pixel, row-major.
@@ -230,6 +233,8 @@ impl ObjectView {
             },
             shadows: u32::from(shot.shadows),
             two: 2,
+            lens: shot.lens.radius.max(0.0) as f32,
+            focus: shot.lens.focus as f32,
             ..Default::default()
         };
         let material = MaterialParams {

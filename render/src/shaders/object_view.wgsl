@@ -16,7 +16,7 @@ fn object_main(@builtin(global_invocation_id) id: vec3<u32>) {
     loop_cut = false;
     let p = vec2<f32>(f32(id.x) + 0.5, f32(id.y) + 0.5);
     let raw = object.dir00 + object.step_x * p.x + object.step_y * p.y;
-    let cone = Cone(object.eye, normalize(raw), 0.0, object.spread);
+    let cone = Cone(object.eye, normalize(raw), 0.0, object.spread, object.lens, object.focus);
     let px = trace(cone, object.mode);
     note_budget(object_two());
     if (loop_cut) {

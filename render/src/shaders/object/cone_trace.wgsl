@@ -11,12 +11,26 @@ const MODE_NEAREST: u32 = 2u;
 // Elements one march may take before it is cut (noted; core allows 65536).
 const MAX_ELEMENTS: u32 = 4096u;
 
-// Cone: apex `origin`, unit axis `dir`, radius radius0 + spread·t at distance t.
+// Cone: apex `origin`, unit axis `dir`, radius `cone_radius` at distance t (a thin lens of radius
+// `lens` focused at `focus` widens it; lens 0 is a pinhole).
 struct Cone {
     origin: vec3<f32>,
     dir: vec3<f32>,
     radius0: f32,
     spread: f32,
+    lens: f32,
+    focus: f32,
+}
+
+// Cone::radius [HN12 Sec. 4.1, Fig. 1d]: the footprint and the lens's circle of confusion as
+// independent discs, √(a² + b²).
+fn cone_radius(cone: Cone, t: f32) -> f32 {
+    let a = cone.radius0 + cone.spread * t;
+    if (!(cone.lens > 0.0 && cone.focus > 0.0)) {
+        return a;
+    }
+    let b = cone.lens * (1.0 - t / cone.focus);
+    return sqrt(a * a + b * b);
 }
 
 // Coverage: the A-buffer's covered sub-rays (masks, nearest) or the opacity (alpha blending).
@@ -155,7 +169,7 @@ fn march_next(cone: Cone, mode: u32, st: ptr<function, MarchState>) -> Element {
         }
         (*st).steps += 1u;
         let t = (*st).t;
-        let r = max(cone.radius0 + cone.spread * t, 1e-9 * object.half);
+        let r = max(cone_radius(cone, t), 1e-9 * object.half);
         let c = cone.origin + cone.dir * (t + r);
         let level = clamp(log2(object.half / r), 0.0, f32(object.depth));
         var s: VoxelSample;
@@ -226,7 +240,7 @@ fn sun_visibility(c: vec3<f32>, normal: vec3<f32>, r: f32, mode: u32) -> f32 {
     let light = object.light;
     let cs = max(dot(normal, light), 1.0 / 16.0);
     let start = r * (1.0 + sqrt(max(1.0 - cs * cs, 0.0)) / cs);
-    let shadow = Cone(c + light * start, light, r, 0.0);
+    let shadow = Cone(c + light * start, light, r, 0.0, 0.0, 1.0);
     let fr = orthonormal_pair(light);
     var cover = Coverage(vec2<u32>(0u, 0u), 0.0);
     var st = march_start(shadow);
