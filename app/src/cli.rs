@@ -283,9 +283,16 @@ pub enum Command {
         /// Sun azimuth, degrees.
         #[arg(long, default_value_t = -37.0, value_parser = azimuth)]
         light_azimuth_deg: f64,
-        /// Ground-truth rays per pixel (1 to 4096).
+        /// Ground-truth rays per pixel (1 to 4096), before the truth is refined (--truth-se).
         #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=4096))]
         rays: u32,
+        /// Refine the truth until the covered mean's relative standard error is at most this many
+        /// percent (0: no refinement; rays go where the variance is, at most --max-rays a pixel).
+        #[arg(long, default_value_t = 0.5, value_parser = truth_se)]
+        truth_se: f64,
+        /// The most truth rays any pixel may get when refining (64 to 10⁶).
+        #[arg(long, default_value_t = 16384, value_parser = clap::value_parser!(u32).range(64..=1_000_000))]
+        max_rays: u32,
         /// Folder for the PNG strips (created if needed; none: only the table).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -567,6 +574,11 @@ pub fn azimuth(s: &str) -> Result<f64, String> {
 pub fn distance(s: &str) -> Result<f64, String> {
     let (lo, hi) = crate::editor::view_state::DISTANCE_RANGE;
     number_in(s, lo, hi, "the camera distance (world units)")
+}
+
+/// A target relative standard error in percent: 0 (none) to 100.
+pub fn truth_se(s: &str) -> Result<f64, String> {
+    number_in(s, 0.0, 100.0, "the truth's standard error target (percent)")
 }
 
 /// A thin lens's radius: 0 (a pinhole) to 10 world units.

@@ -442,12 +442,16 @@ fn run(cli: Cli) -> Result<()> {
             gpu,
             lens,
             focus,
+            truth_se,
+            max_rays,
         }) => {
             let opts = object_cmd::Options {
                 shadows: !no_shadows,
                 gpu,
                 lens,
                 focus,
+                truth_se: truth_se / 100.0,
+                max_rays: max_rays as usize,
                 shape: object_cmd::shape(shape.name(), mesh.as_deref(), radius, minor)?,
                 depth,
                 size,

@@ -56,6 +56,11 @@ pub struct Options {
     pub lens: f64,
     /// The distance in focus (none: each distance's, the object's centre).
     pub focus: Option<f64>,
+    /// The truth is refined until its covered mean's relative standard error is at most this
+    /// (0: not refined).
+    pub truth_se: f64,
+    /// The most truth rays a pixel may get when refining.
+    pub max_rays: usize,
 }
 
 /// The base shape named on the command line; a mesh is read and checked here.
@@ -137,7 +142,7 @@ pub fn run(material: &Material, opts: &Options) -> Result<String> {
     let gpu_col = if gpu.is_some() { " / masks (GPU)" } else { "" };
     writeln!(
         text,
-        "| distance | across | covered / silhouette px | truth's s.e. | mean colour error: nearest / alpha / masks{gpu_col} | silhouette coverage error: nearest / alpha / masks{gpu_col} | µs a pixel: nearest / alpha / masks (CPU, one core){gpu_col} |"
+        "| distance | across | covered / silhouette px | truth's s.e. (rays a covered pixel) | mean colour error: nearest / alpha / masks{gpu_col} | silhouette coverage error: nearest / alpha / masks{gpu_col} | µs a pixel: nearest / alpha / masks (CPU, one core){gpu_col} |"
     )?;
     writeln!(text, "|---|---|---|---|---|---|---|")?;
     for &distance in &opts.distances {
@@ -159,7 +164,16 @@ pub fn run(material: &Material, opts: &Options) -> Result<String> {
             let (px, seconds) = g.render(&shot, true)?;
             images.views.push((Compositing::Masks, px, seconds));
         }
+        if opts.truth_se > 0.0 {
+            images.converge_truth(&truth, &camera, lens, opts.truth_se, opts.max_rays);
+        }
         let e = images.errors();
+        let covered_rays: Vec<usize> = (0..images.truth.len())
+            .filter(|&i| images.truth[i].coverage >= 0.99)
+            .map(|i| images.truth_rays[i])
+            .collect();
+        let mean_rays =
+            covered_rays.iter().sum::<usize>() as f64 / covered_rays.len().max(1) as f64;
         let pixel = 2.0 * camera.tan_half_fov() / f64::from(opts.size.1);
         let across = 2.0 * object.bounding_radius() / distance / pixel;
         let touched = (e.covered + e.silhouette).max(1) as f64;
@@ -168,7 +182,7 @@ pub fn run(material: &Material, opts: &Options) -> Result<String> {
         };
         writeln!(
             text,
-            "| {distance} | {across:.0} px | {} / {} | {:.2}% | {} | {} | {} |",
+            "| {distance} | {across:.0} px | {} / {} | {:.2}% ({mean_rays:.0}) | {} | {} | {} |",
             e.covered,
             e.silhouette,
             100.0 * e.truth_error,

@@ -244,7 +244,7 @@ fn run(jobs: Receiver<Job>, shared: Arc<Mutex<Shared>>, repaint: impl Fn()) {
                 Compositing::AlphaBlend,
                 Compositing::Masks,
             ];
-            let images = ObjectImages::render(
+            let mut images = ObjectImages::render(
                 &truth,
                 &tracer,
                 &shot.camera,
@@ -253,6 +253,9 @@ fn run(jobs: Receiver<Job>, shared: Arc<Mutex<Shared>>, repaint: impl Fn()) {
                 &modes,
                 shot.lens,
             );
+            set(&shared, |s| s.status = "Refining the ground truth to 0.5%…".into());
+            repaint();
+            images.converge_truth(&truth, &shot.camera, shot.lens, 0.005, 4096);
             let errors = images.errors();
             let names = ["nearest voxels", "alpha blended", "ours (masks)"];
             let mut panels: Vec<(&'static str, Vec<ConePixel>)> = names

@@ -50,6 +50,8 @@ pub struct ObjectImages {
     pub height: u32,
     /// The ground truth.
     pub truth: Vec<ConePixel>,
+    /// The truth's rays per pixel ([`ObjectImages::converge_truth`] adds to some).
+    pub truth_rays: Vec<usize>,
     /// Per mode: its pixels and the CPU seconds its cones took (summed over threads).
     pub views: Vec<(Compositing, Vec<ConePixel>, f64)>,
 }
@@ -101,9 +103,97 @@ impl ObjectImages {
         Self {
             width,
             height,
+            truth_rays: vec![rays.max(1); truth_px.len()],
             truth: truth_px,
             views,
         }
+    }
+
+    /// The relative standard error of the truth's covered mean, worst channel (what
+    /// [`ViewErrors::truth_error`] reports).
+    pub fn truth_error(&self) -> f64 {
+        let covered = self.truth.iter().filter(|p| p.coverage >= 0.99);
+        let (mut sums, mut vars) = ([0.0; 3], [0.0; 3]);
+        for p in covered {
+            for k in 0..3 {
+                sums[k] += p.color[k];
+                vars[k] += p.variance[k];
+            }
+        }
+        (0..3)
+            .map(|k| vars[k].sqrt() / sums[k].max(1e-300))
+            .fold(0.0, f64::max)
+    }
+
+    /// Adds truth rays where the covered mean's variance is, until its relative standard error
+    /// ([`ObjectImages::truth_error`]) is at most `target` or no pixel may take more than
+    /// `max_rays`: each round, the fewest covered pixels that hold half the variance get as many
+    /// rays again (a new turn of their spiral), merged with what they had (means and second
+    /// moments weighted by rays). A mean over thousands of pixels whose specular a few facets carry
+    /// converges this way at a fraction of uniform rays; a glint no ray has drawn stays unseen,
+    /// as in any sampling. `camera` and `lens` must be the ones rendered. Returns the rays added.
+    pub fn converge_truth(
+        &mut self,
+        truth: &ObjectTruth,
+        camera: &Camera,
+        lens: Lens,
+        target: f64,
+        max_rays: usize,
+    ) -> usize {
+        use rayon::prelude::*;
+        let (w, h) = (self.width, self.height);
+        let mut added = 0;
+        for round in 1..=24u64 {
+            if self.truth_error() <= target {
+                break;
+            }
+            let mut sums = [0.0f64; 3];
+            for p in self.truth.iter().filter(|p| p.coverage >= 0.99) {
+                for k in 0..3 {
+                    sums[k] += p.color[k];
+                }
+            }
+            let weight = |p: &ConePixel| {
+                (0..3)
+                    .map(|k| p.variance[k] / sums[k].max(1e-300).powi(2))
+                    .sum::<f64>()
+            };
+            let mut order: Vec<usize> = (0..self.truth.len())
+                .filter(|&i| self.truth[i].coverage >= 0.99 && self.truth_rays[i] < max_rays)
+                .collect();
+            order.sort_by(|&a, &b| weight(&self.truth[b]).total_cmp(&weight(&self.truth[a])));
+            let total: f64 = order.iter().map(|&i| weight(&self.truth[i])).sum();
+            if !(total > 0.0) {
+                break;
+            }
+            let mut acc = 0.0;
+            let chosen: Vec<usize> = order
+                .into_iter()
+                .take_while(|&i| {
+                    let before = acc;
+                    acc += weight(&self.truth[i]);
+                    before < 0.5 * total
+                })
+                .collect();
+            let fresh: Vec<(usize, usize, ConePixel)> = chosen
+                .par_iter()
+                .map(|&i| {
+                    let (x, y) = (i as u32 % w, i as u32 / w);
+                    let cone = pixel_cone(camera, f64::from(x) + 0.5, f64::from(y) + 0.5, w, h)
+                        .with_lens(lens.radius, lens.focus);
+                    let n = self.truth_rays[i].min(max_rays - self.truth_rays[i]).max(1);
+                    let seed = round * u64::from(w * h) + i as u64;
+                    (i, n, truth.pixel(&cone, n, seed))
+                })
+                .collect();
+            for (i, n, p) in fresh {
+                let m = self.truth_rays[i];
+                self.truth[i] = merge(&self.truth[i], m, &p, n);
+                self.truth_rays[i] = m + n;
+                added += n;
+            }
+        }
+        added
     }
 
     /// Each mode's errors against the truth (module docs).
@@ -172,6 +262,25 @@ impl ObjectImages {
             modes,
         }
     }
+}
+
+/// Two estimates of one pixel from `m` and `n` rays as one of `m + n` (means and second moments
+/// weighted by rays; the variance of the merged mean from the merged second moment).
+fn merge(a: &ConePixel, m: usize, b: &ConePixel, n: usize) -> ConePixel {
+    let (fm, fn_, t) = (m as f64, n as f64, (m + n) as f64);
+    let second = |p: &ConePixel, k: usize, c: f64| {
+        p.variance[k] * (c - 1.0).max(1.0) + p.color[k] * p.color[k]
+    };
+    let mut out = ConePixel {
+        coverage: (fm * a.coverage + fn_ * b.coverage) / t,
+        ..ConePixel::default()
+    };
+    for k in 0..3 {
+        out.color[k] = (fm * a.color[k] + fn_ * b.color[k]) / t;
+        let sq = (fm * second(a, k, fm) + fn_ * second(b, k, fn_)) / t;
+        out.variance[k] = (sq - out.color[k] * out.color[k]).max(0.0) / (t - 1.0).max(1.0);
+    }
+    out
 }
 
 /// Renders with [`ObjectImages::render`] and measures with [`ObjectImages::errors`].
@@ -266,6 +375,48 @@ mod tests {
             assert!(masks.coverage_error * 3.0 < alpha.coverage_error, "{e:?}");
             assert!(masks.coverage_error * 3.0 < nearest.coverage_error, "{e:?}");
             assert!(masks.mean_color_error < 0.04, "{e:?}");
+        });
+    }
+
+    /// Merging two batches of rays gives the statistics of all of them at once.
+    #[test]
+    fn merging_batches_is_one_batch() {
+        let stats = |v: &[f64]| {
+            let n = v.len() as f64;
+            let mean = v.iter().sum::<f64>() / n;
+            let sq = v.iter().map(|x| x * x).sum::<f64>() / n;
+            ConePixel {
+                color: [mean; 3],
+                coverage: 1.0,
+                variance: [(sq - mean * mean).max(0.0) / (n - 1.0); 3],
+            }
+        };
+        let all = [0.1, 0.5, 0.2, 9.0, 0.3, 0.25, 0.4];
+        let m = merge(&stats(&all[..3]), 3, &stats(&all[3..]), 4);
+        let whole = stats(&all);
+        assert!((m.color[0] - whole.color[0]).abs() < 1e-12);
+        assert!((m.variance[0] - whole.variance[0]).abs() < 1e-12);
+    }
+
+    /// Adaptive truth rays: from 4 rays a pixel (the covered mean's standard error some percent,
+    /// the specular's facets) to a target of 0.5%, with fewer rays than giving every covered
+    /// pixel the most any pixel got.
+    #[test]
+    fn the_truth_converges_where_its_variance_is() {
+        with_scene(4, |_, truth, tracer| {
+            let cam = camera(4.0);
+            let mut img =
+                ObjectImages::render(truth, tracer, &cam, (24, 18), 4, &[], Lens::PINHOLE);
+            let before = img.truth_error();
+            let added = img.converge_truth(truth, &cam, Lens::PINHOLE, 0.005, 1024);
+            let after = img.truth_error();
+            let covered = img.truth.iter().filter(|p| p.coverage >= 0.99).count();
+            let most = img.truth_rays.iter().copied().max().unwrap();
+            eprintln!(
+                "{before:.4} -> {after:.4} with {added} rays; {covered} covered, most {most}"
+            );
+            assert!(before > 0.005 && after <= 0.005, "{before} {after}");
+            assert!(added < covered * (most - 4), "{added} {covered} {most}");
         });
     }
 
