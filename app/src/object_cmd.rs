@@ -3,7 +3,9 @@
 //! and with `--gpu` in WGSL on the adapter, beside its ray-traced ground truth, over a zoom sweep.
 //! For each distance: a PNG strip (nearest voxels | alpha blended | masks, HN12 | ground truth |
 //! GPU masks) and a table row of the colour error of covered pixels, the silhouette's coverage
-//! error and the time per pixel. Bad shapes, meshes and materials are usage errors (exit code 2).
+//! error and the time per pixel; with `--out`, the strips and the report as `object.md` (the table)
+//! and `object.json` (every number, unrounded, with the octree's memory per level). Bad shapes,
+//! meshes and materials are usage errors (exit code 2).
 
 use crate::UsageError;
 use crate::object_scene::{GpuObject, ObjectScene, lighting, masks_shot};
@@ -145,6 +147,7 @@ pub fn run(material: &Material, opts: &Options) -> Result<String> {
         "| distance | across | covered / silhouette px | truth's s.e. (rays a covered pixel) | mean colour error: nearest / alpha / masks{gpu_col} | silhouette coverage error: nearest / alpha / masks{gpu_col} | µs a pixel: nearest / alpha / masks (CPU, one core){gpu_col} |"
     )?;
     writeln!(text, "|---|---|---|---|---|---|---|")?;
+    let mut rows = vec![];
     for &distance in &opts.distances {
         let camera = Camera {
             elevation_deg: opts.view.0,
@@ -200,8 +203,62 @@ pub fn run(material: &Material, opts: &Options) -> Result<String> {
                 .save(&path)
                 .with_context(|| format!("writing {}", path.display()))?;
         }
+        rows.push(Row {
+            distance,
+            across_px: across,
+            lens,
+            truth_rays_per_covered_pixel: mean_rays,
+            errors: e,
+        });
+    }
+    if let Some(out) = &opts.out {
+        let report = Report {
+            material: material.name.clone(),
+            shape: kind_name(&opts.shape),
+            depth: opts.depth,
+            build_seconds: build,
+            gpu_bytes_per_voxel: lodestone_core::object::octree::GPU_BYTES_PER_VOXEL,
+            levels: scene.memory.clone(),
+            gpu: gpu.as_ref().map(|g| g.ctx.describe()),
+            modes: MODES
+                .iter()
+                .map(|m| format!("{m:?} (CPU)"))
+                .chain(gpu.iter().map(|_| "Masks (GPU)".to_string()))
+                .collect(),
+            rows,
+        };
+        let json = serde_json::to_string_pretty(&report)?;
+        for (name, body) in [("object.json", json.as_str()), ("object.md", text.as_str())] {
+            let path = out.join(name);
+            crate::preset_io::write_atomic(&path, body)
+                .with_context(|| format!("writing {}", path.display()))?;
+        }
     }
     Ok(text)
+}
+
+/// One distance of the sweep, as `object.json` holds it.
+#[derive(serde::Serialize)]
+struct Row {
+    distance: f64,
+    across_px: f64,
+    lens: Lens,
+    truth_rays_per_covered_pixel: f64,
+    errors: lodestone_core::object::view_error::ViewErrors,
+}
+
+/// `object.json`: the sweep's settings and rows (the table's numbers, unrounded).
+#[derive(serde::Serialize)]
+struct Report {
+    material: String,
+    shape: &'static str,
+    depth: u32,
+    build_seconds: f64,
+    gpu_bytes_per_voxel: usize,
+    levels: Vec<lodestone_core::object::octree::LevelMemory>,
+    gpu: Option<String>,
+    modes: Vec<String>,
+    rows: Vec<Row>,
 }
 
 fn kind_name(s: &BaseShape) -> &'static str {

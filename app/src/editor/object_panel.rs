@@ -253,7 +253,9 @@ fn run(jobs: Receiver<Job>, shared: Arc<Mutex<Shared>>, repaint: impl Fn()) {
                 &modes,
                 shot.lens,
             );
-            set(&shared, |s| s.status = "Refining the ground truth to 0.5%…".into());
+            set(&shared, |s| {
+                s.status = "Refining the ground truth to 0.5%…".into()
+            });
             repaint();
             images.converge_truth(&truth, &shot.camera, shot.lens, 0.005, 4096);
             let errors = images.errors();

@@ -28,7 +28,7 @@ use crate::object::voxel_field::{VoxelField, VoxelSample};
 use glam::DVec3;
 
 /// How a cone combines the elements it meets (module docs).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
 pub enum Compositing {
     /// HN12: sub-pixel masks combined A-buffer style (ours).
     Masks,

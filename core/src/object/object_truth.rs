@@ -118,7 +118,7 @@ pub fn pixel_cone(
 
 /// A thin lens: its radius (world units; 0 for a pinhole) and the distance along each pixel's axis
 /// that is in focus (#19, depth of field by wider cones [HN12 Sec. 4.1, Fig. 1d]).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Lens {
     /// Lens radius, world units (0: a pinhole).
     pub radius: f64,

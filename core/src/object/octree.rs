@@ -34,7 +34,7 @@ pub struct VoxelOctree {
 }
 
 /// One level's storage.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct LevelMemory {
     /// The level (0 = root).
     pub level: u32,

@@ -12,7 +12,7 @@ use crate::object::object_truth::{Lens, ObjectTruth, pixel_cone};
 use crate::scene::camera::Camera;
 
 /// One mode's errors over an image.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct ModeErrors {
     /// The compositing mode.
     pub mode: Compositing,
@@ -27,7 +27,7 @@ pub struct ModeErrors {
 }
 
 /// An image's errors: the pixels counted and each mode's errors.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct ViewErrors {
     /// Pixels the truth covers fully.
     pub covered: usize,
