@@ -1341,9 +1341,18 @@ fn object_refuses_bad_input_and_renders_a_small_sweep() {
     let row = &json["rows"][0];
     assert_eq!(row["distance"], 6.0);
     assert_eq!(row["errors"]["modes"].as_array().unwrap().len(), 3);
-    assert!(row["errors"]["modes"][2]["mean_color_error"].as_f64().unwrap() < 0.2);
+    assert!(
+        row["errors"]["modes"][2]["mean_color_error"]
+            .as_f64()
+            .unwrap()
+            < 0.2
+    );
     assert_eq!(json["levels"].as_array().unwrap().len(), 5);
-    assert!(std::fs::read_to_string(strips.join("object.md")).unwrap().contains("| 6 |"));
+    assert!(
+        std::fs::read_to_string(strips.join("object.md"))
+            .unwrap()
+            .contains("| 6 |")
+    );
     // Through a lens, with the WGSL masks beside the CPU's: a fifth panel and column, the same
     // errors up to the f16 storage (the GPU test holds the two equal over the same stored field).
     let out = lodestone(&[

@@ -135,3 +135,48 @@ fn cone_traced_pixels_match_core() {
         }
     }
 }
+
+/// The adapter's loop budget (Mesa: 65535 iterations an invocation) holds on the longest cones: a
+/// torus filling the view, cones passing through its hole and along its inner side, shadow cones
+/// on. Every pixel finishes (no loop cut) in each mode.
+#[test]
+fn long_cones_fit_the_loop_budget() {
+    let Some(ctx) = lodestone_tests::gpu("the object loop budget test") else {
+        return;
+    };
+    let material = Material::default();
+    let ev = Evaluator::new(&material).unwrap();
+    let shape = BaseShape::Torus {
+        major: 2.0,
+        minor: 0.8,
+    };
+    let object = DisplacedObject::new(&material, shape).unwrap();
+    let tree = VoxelOctree::of_object(&object, |f| ev.color_at(f), 7, 2.0, 1);
+    let voxels = GpuVoxels::encode(&VoxelField::new(&tree));
+    let lighting = ObjectLighting {
+        light: direction(37f64.to_radians(), (-37f64).to_radians()),
+        sun: material.lighting.sun,
+        brdf: material.brdf.clone(),
+        correlation: material.filtering.correlation,
+    };
+    let view = ObjectView::new(&ctx);
+    let octree = view.upload(&ctx, &voxels).unwrap();
+    let cam = camera(3.0);
+    for mode in [
+        Compositing::Masks,
+        Compositing::AlphaBlend,
+        Compositing::Nearest,
+    ] {
+        let shot = ObjectShot {
+            camera: &cam,
+            lighting: &lighting,
+            mode,
+            shadows: true,
+            size: (160, 120),
+            lens: Lens::PINHOLE,
+        };
+        let img = view.render(&ctx, &octree, &shot).unwrap();
+        eprintln!("{mode:?}: {} of {} pixels cut", img.cut, 160 * 120);
+        assert_eq!(img.cut, 0, "{mode:?}");
+    }
+}

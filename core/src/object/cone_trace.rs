@@ -280,20 +280,26 @@ impl ConeTracer<'_> {
 
     /// Where the cone may next find support after an element at t without any: the exit of the
     /// coarsest empty voxel holding the element's centre, less one voxel of the sampled level.
+    /// Emptiness only grows with the level (a voxel holds surface only if its parent does), so the
+    /// coarsest empty level is found by bisection (four lookups for the deepest octree, where a
+    /// walk from the root took up to thirteen).
     fn skip(&self, cone: &Cone, t: f64, r: f64, level: f64) -> f64 {
         let f = self.field;
         let c = cone.origin + cone.dir * (t + r);
         let fine = level.floor().clamp(0.0, f64::from(f.depth())) as u32;
-        let mut empty = None;
-        for l in 0..=fine {
-            if f.nearest(c, l).is_none() {
-                empty = Some(l);
-                break;
+        let (mut lo, mut hi) = (0u32, fine + 1);
+        while lo < hi {
+            let mid = (lo + hi) / 2;
+            if f.nearest(c, mid).is_none() {
+                hi = mid;
+            } else {
+                lo = mid + 1;
             }
         }
-        let Some(l) = empty else {
+        if lo > fine {
             return t;
-        };
+        }
+        let l = lo;
         let size = f.voxel_size(l);
         let lo = ((c + DVec3::splat(f.half)) / size).floor() * size - DVec3::splat(f.half);
         let exit = box_exit(cone.origin, cone.dir, lo, lo + DVec3::splat(size));

@@ -1,7 +1,7 @@
 //! The voxel octree as the GPU reads it (#19, [HN12 Sec. 5.2]): every occupied voxel of every level
 //! as 32 bytes ([`GPU_BYTES_PER_VOXEL`]), found through one open-addressing hash table keyed by
 //! (level, x, y, z). HN12 store bricks under a node tree (GigaVoxels); a hash finds a voxel in one
-//! probe at a load of at most ½ without a descent, which is what the quadrilinear lookups of a cone
+//! probe (1.2 on average) at a load of at most ¼ without a descent, which is what the quadrilinear lookups of a cone
 //! element (16 voxels) want, and it is built in one pass.
 //!
 //! A voxel's words (`shaders/object/voxel_field.wgsl` `voxel_at` unpacks them):
@@ -25,6 +25,11 @@ use std::collections::HashMap;
 
 /// Bytes of one hash slot (key words, voxel index, padding).
 pub const BYTES_PER_SLOT: usize = 16;
+
+/// Every key lies within this many slots of its hash (the table grows until it does), so the
+/// shader's lookup is this many probes written out, with no loop (`voxel_field.wgsl`
+/// `find_voxel`; a loop there spent the software adapter's loop budget).
+pub const MAX_PROBES: usize = 8;
 
 /// The octree's voxels and their hash table, as uploaded (module docs).
 #[derive(Clone, Debug, PartialEq)]
@@ -110,17 +115,29 @@ impl GpuVoxels {
                 out.keys.push((level as u32, c));
             }
         }
-        let n = (2 * out.voxels.len()).next_power_of_two().max(16);
-        out.slots = vec![[0; 4]; n];
-        for (i, &(level, c)) in out.keys.iter().enumerate() {
-            let k = slot_key(level, c);
-            let mut s = slot_hash(k) as usize & (n - 1);
-            while out.slots[s][1] != 0 {
-                s = (s + 1) & (n - 1);
+        let mut n = (4 * out.voxels.len()).next_power_of_two().max(16);
+        loop {
+            match Self::hash_keys(&out.keys, n) {
+                Some(slots) => {
+                    out.slots = slots;
+                    return out;
+                }
+                None => n *= 2,
             }
-            out.slots[s] = [k[0], k[1], i as u32, 0];
         }
-        out
+    }
+
+    /// The table of `keys` over `n` slots by linear probing, or `None` when a key would lie
+    /// [`MAX_PROBES`] or more slots past its hash.
+    fn hash_keys(keys: &[(u32, [u32; 3])], n: usize) -> Option<Vec<[u32; 4]>> {
+        let mut slots = vec![[0u32; 4]; n];
+        for (i, &(level, c)) in keys.iter().enumerate() {
+            let k = slot_key(level, c);
+            let home = slot_hash(k) as usize & (n - 1);
+            let free = (0..MAX_PROBES).find(|p| slots[(home + p) & (n - 1)][1] == 0)?;
+            slots[(home + free) & (n - 1)] = [k[0], k[1], i as u32, 0];
+        }
+        Some(slots)
     }
 
     fn encode_voxel(&self, level: u32, c: [u32; 3], d: &VoxelDescriptor) -> [u32; 8] {
@@ -180,20 +197,20 @@ impl GpuVoxels {
         self.voxels.len() * GPU_BYTES_PER_VOXEL + self.slots.len() * BYTES_PER_SLOT
     }
 
-    /// The index of voxel `c` of `level` by the table, as the GPU probes it (for tests).
+    /// The index of voxel `c` of `level` by the table, as the GPU probes it: at most
+    /// [`MAX_PROBES`] slots from its hash (for tests).
     pub fn find(&self, level: u32, c: [u32; 3]) -> Option<usize> {
         let k = slot_key(level, c);
         let mask = self.slots.len() - 1;
-        let mut s = slot_hash(k) as usize & mask;
-        for _ in 0..self.slots.len() {
-            let e = self.slots[s];
+        let home = slot_hash(k) as usize & mask;
+        for p in 0..MAX_PROBES {
+            let e = self.slots[(home + p) & mask];
             if e[0] == k[0] && e[1] == k[1] {
                 return Some(e[2] as usize);
             }
             if e[1] == 0 {
                 return None;
             }
-            s = (s + 1) & mask;
         }
         None
     }
@@ -223,7 +240,9 @@ mod tests {
             g.voxels.len(),
             f.levels.iter().map(|l| l.len()).sum::<usize>()
         );
-        assert!(g.slots.len() >= 2 * g.voxels.len() && g.slots.len().is_power_of_two());
+        assert!(g.slots.len() >= 4 * g.voxels.len() && g.slots.len().is_power_of_two());
+        // A table too small for MAX_PROBES is refused, and encode grows past it.
+        assert!(GpuVoxels::hash_keys(&g.keys, 16).is_none());
         for (i, &(level, c)) in g.keys.iter().enumerate() {
             assert_eq!(g.find(level, c), Some(i));
         }
@@ -328,6 +347,16 @@ mod tests {
             assert!(sa > 1.0 && rel < 3e-3, "distance {distance}: {rel}");
             assert!(cov < 1.0 / 64.0, "distance {distance}: coverage {cov}");
         }
+    }
+
+    /// The shader probes exactly MAX_PROBES slots.
+    #[test]
+    fn the_shader_probes_as_far_as_the_table_guarantees() {
+        let src = crate::shaders::object();
+        let f = &src[src.find("fn find_voxel(").unwrap()..];
+        let body = &f[..f.find("\n}\n").unwrap()];
+        assert_eq!(body.matches("probe_slot(k,").count(), MAX_PROBES);
+        assert!(!body.contains("loop") && !body.contains("for ("));
     }
 
     /// Extreme values stay finite.

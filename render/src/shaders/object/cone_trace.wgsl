@@ -79,57 +79,69 @@ fn element_mask(s: VoxelSample, e1: vec3<f32>, e2: vec3<f32>, d: vec3<f32>, r: f
     return mask_lookup(p.x, p.y);
 }
 
+// GPU only: the slab of one axis, (entry, exit) of the ray between lo and hi along it; the whole
+// line (or none of it) when the ray is parallel to the slab. Written per axis, not looped: a loop
+// spends the adapter's loop budget (bindings.wgsl).
+fn axis_slab(o: f32, d: f32, lo: f32, hi: f32) -> vec2<f32> {
+    if (abs(d) < 1e-30) {
+        return select(vec2<f32>(3.0e38, -3.0e38), vec2<f32>(-3.0e38, 3.0e38), o >= lo && o <= hi);
+    }
+    let u = (lo - o) / d;
+    let v = (hi - o) / d;
+    return vec2<f32>(min(u, v), max(u, v));
+}
+
 // cube_span: the ray's span (t0, t1) inside the cube [−half, half]³; z = 1 when it meets it.
 fn cube_span(o: vec3<f32>, d: vec3<f32>, half: f32) -> vec3<f32> {
-    var t0 = 0.0;
-    var t1 = 3.0e38;
-    for (var a = 0u; a < 3u; a = a + 1u) {
-        if (abs(d[a]) < 1e-30) {
-            if (abs(o[a]) > half) {
-                return vec3<f32>(0.0);
-            }
-            continue;
-        }
-        let u = (-half - o[a]) / d[a];
-        let v = (half - o[a]) / d[a];
-        t0 = max(t0, min(u, v));
-        t1 = min(t1, max(u, v));
-    }
+    let x = axis_slab(o.x, d.x, -half, half);
+    let y = axis_slab(o.y, d.y, -half, half);
+    let z = axis_slab(o.z, d.z, -half, half);
+    let t0 = max(0.0, max(x.x, max(y.x, z.x)));
+    let t1 = min(x.y, min(y.y, z.y));
     return vec3<f32>(t0, t1, select(0.0, 1.0, t1 > t0));
 }
 
 // box_exit: where the ray leaves the box [lo, hi].
 fn box_exit(o: vec3<f32>, d: vec3<f32>, lo: vec3<f32>, hi: vec3<f32>) -> f32 {
-    var t1 = 3.0e38;
-    for (var a = 0u; a < 3u; a = a + 1u) {
-        if (abs(d[a]) > 1e-30) {
-            let u = (lo[a] - o[a]) / d[a];
-            let v = (hi[a] - o[a]) / d[a];
-            t1 = min(t1, max(u, v));
-        }
-    }
-    return t1;
+    let x = axis_slab(o.x, d.x, lo.x, hi.x);
+    let y = axis_slab(o.y, d.y, lo.y, hi.y);
+    let z = axis_slab(o.z, d.z, lo.z, hi.z);
+    return min(x.y, min(y.y, z.y));
 }
 
-// ConeTracer::skip: past the largest empty voxel around the element (t itself when every level
-// down to the element's is occupied there).
+// ConeTracer::skip: past the coarsest empty voxel around the element (t itself when every level
+// down to the element's is occupied there). Emptiness only grows with the level, so the coarsest
+// empty level is bisected: four steps, written out (no loop), cover the 13 levels of the deepest
+// octree (MAX_DEPTH 12).
 fn skip(cone: Cone, t: f32, r: f32, level: f32) -> f32 {
     let c = cone.origin + cone.dir * (t + r);
     let fine = u32(clamp(floor(level), 0.0, f32(object.depth)));
-    var empty = fine + 1u;
-    for (var l = 0u; l <= fine; l = l + 1u) {
-        if (nearest(c, l) < 0) {
-            empty = l;
-            break;
-        }
-    }
-    if (empty > fine) {
+    var lo = 0u;
+    var hi = fine + 1u;
+    bisect_empty(c, &lo, &hi);
+    bisect_empty(c, &lo, &hi);
+    bisect_empty(c, &lo, &hi);
+    bisect_empty(c, &lo, &hi);
+    if (lo > fine) {
         return t;
     }
-    let size = voxel_size(empty);
-    let lo = floor((c + vec3<f32>(object.half)) / size) * size - vec3<f32>(object.half);
-    let exit = box_exit(cone.origin, cone.dir, lo, lo + vec3<f32>(size));
+    let size = voxel_size(lo);
+    let base = floor((c + vec3<f32>(object.half)) / size) * size - vec3<f32>(object.half);
+    let exit = box_exit(cone.origin, cone.dir, base, base + vec3<f32>(size));
     return exit - voxel_size(fine) - r;
+}
+
+// GPU only: one bisection step of skip (its loop body): the coarsest empty level lies in [lo, hi].
+fn bisect_empty(c: vec3<f32>, lo: ptr<function, u32>, hi: ptr<function, u32>) {
+    if (*lo >= *hi) {
+        return;
+    }
+    let mid = (*lo + *hi) / 2u;
+    if (nearest(c, mid) < 0) {
+        *hi = mid;
+    } else {
+        *lo = mid + 1u;
+    }
 }
 
 // Where a march is: the next element's distance, the span's end, elements taken.
@@ -139,11 +151,18 @@ struct MarchState {
     steps: u32,
 }
 
-// One element of a march: the field there, its centre and radius; `sample.found` false at the end.
+// One element of a march: the field there, its centre and radius; `sample.found` false where the
+// step met no support.
 struct Element {
     sample: VoxelSample,
     c: vec3<f32>,
     r: f32,
+}
+
+// One step of a march and whether the march has ended.
+struct Step {
+    e: Element,
+    done: bool,
 }
 
 // ConeTracer::march, first half: the span inside the octree's cube (an empty span where it misses).
@@ -155,77 +174,116 @@ fn march_start(cone: Cone) -> MarchState {
     return MarchState(span.x, span.y, 0u);
 }
 
-// ConeTracer::march, its loop: the next element that holds a sample (empty space skipped).
-fn march_next(cone: Cone, mode: u32, st: ptr<function, MarchState>) -> Element {
-    var e: Element;
-    e.sample.found = false;
-    loop {
-        if ((*st).t >= (*st).t1) {
-            return e;
-        }
-        if ((*st).steps >= MAX_ELEMENTS) {
-            note_cut(true);
-            return e;
-        }
-        (*st).steps += 1u;
-        let t = (*st).t;
-        let r = max(cone_radius(cone, t), 1e-9 * object.half);
-        let c = cone.origin + cone.dir * (t + r);
-        let level = clamp(log2(object.half / r), 0.0, f32(object.depth));
-        var s: VoxelSample;
-        if (mode == MODE_NEAREST) {
-            let lv = u32(floor(level + 0.5));
-            let i = nearest(c, lv);
-            s.found = i >= 0;
-            if (s.found) {
-                let d = voxel_at(u32(i));
-                let f = orthonormal_pair(d.normal);
-                s.distance = -1.0;
-                s.normal = d.normal;
-                s.height_var = d.height_var;
-                s.slope_cov = d.slope_cov;
-                s.t1 = f.t1;
-                s.t2 = f.t2;
-                s.color_mean = d.color_mean;
-                s.color_height = d.color_height;
-                s.support = 1.0;
-            }
-        } else {
-            s = voxel_sample(c, level);
-        }
-        if (s.found) {
-            (*st).t = t + 2.0 * r;
-            return Element(s, c, r);
-        }
-        (*st).t = max(skip(cone, t, r, level), t + 2.0 * r);
+// ConeTracer::march, one pass of its loop: the element at the state's distance, or a skip past
+// empty space (`sample.found` false); `done` once the span has ended. The caller's one loop calls
+// it (see trace).
+fn march_step(cone: Cone, mode: u32, st: ptr<function, MarchState>) -> Step {
+    var out: Step;
+    out.e.sample.found = false;
+    out.done = false;
+    if ((*st).t >= (*st).t1) {
+        out.done = true;
+        return out;
     }
-    return e;
+    if ((*st).steps >= MAX_ELEMENTS) {
+        note_cut(true);
+        out.done = true;
+        return out;
+    }
+    (*st).steps += 1u;
+    let t = (*st).t;
+    let r = max(cone_radius(cone, t), 1e-9 * object.half);
+    let c = cone.origin + cone.dir * (t + r);
+    let level = clamp(log2(object.half / r), 0.0, f32(object.depth));
+    var s: VoxelSample;
+    if (mode == MODE_NEAREST) {
+        let lv = u32(floor(level + 0.5));
+        let i = nearest(c, lv);
+        s.found = i >= 0;
+        if (s.found) {
+            let d = voxel_at(u32(i));
+            let f = orthonormal_pair(d.normal);
+            s.distance = -1.0;
+            s.normal = d.normal;
+            s.height_var = d.height_var;
+            s.slope_cov = d.slope_cov;
+            s.t1 = f.t1;
+            s.t2 = f.t2;
+            s.color_mean = d.color_mean;
+            s.color_height = d.color_height;
+            s.support = 1.0;
+        }
+    } else {
+        s = voxel_sample(c, level);
+    }
+    if (s.found) {
+        (*st).t = t + 2.0 * r;
+        out.e = Element(s, c, r);
+        return out;
+    }
+    (*st).t = max(skip(cone, t, r, level), t + 2.0 * r);
+    return out;
 }
 
-// ConeTracer::trace: a pixel's colour (rgb) and covered share (a).
+// ConeTracer::trace: a pixel's colour (rgb) and covered share (a). Core's trace visits the view
+// cone's elements and, inside that visit, marches each lit element's shadow cone; here one loop
+// runs both, a step of the view cone or of the shadow cone in flight per pass: the adapter's loop
+// budget (bindings.wgsl) counts a nested loop's passes for the slowest lane of the batch at every
+// pass of the outer loop, one loop only the slowest lane's steps.
 fn trace(cone: Cone, mode: u32) -> vec4<f32> {
     let fr = orthonormal_pair(cone.dir);
+    let lf = orthonormal_pair(object.light);
     var cover = Coverage(vec2<u32>(0u, 0u), 0.0);
     var color = vec3<f32>(0.0);
     var st = march_start(cone);
+    // The shadow cone in flight, its coverage, the element it decides and that element's weight.
+    var shadowing = false;
+    var shadow: Cone;
+    var sst: MarchState;
+    var scover: Coverage;
+    var pending: VoxelSample;
+    var pending_weight = 0.0;
     loop {
-        let e = march_next(cone, mode, &st);
-        if (!e.sample.found) {
+        if (shadowing) {
+            let step = march_step(shadow, mode, &sst);
+            if (step.e.sample.found) {
+                coverage_add(&scover, element_mask(step.e.sample, lf.t1, lf.t2, object.light, step.e.r, mode), mode);
+            }
+            if (step.done || coverage_full(scover, mode)) {
+                let sun = 1.0 - coverage_share(scover, mode);
+                color += pending_weight * element_radiance(pending, -cone.dir, sun);
+                shadowing = false;
+                if (coverage_full(cover, mode)) {
+                    break;
+                }
+            }
+            continue;
+        }
+        let step = march_step(cone, mode, &st);
+        if (step.done) {
             break;
         }
-        let s = e.sample;
-        let mask = element_mask(s, fr.t1, fr.t2, cone.dir, e.r, mode);
+        if (!step.e.sample.found) {
+            continue;
+        }
+        let s = step.e.sample;
+        let mask = element_mask(s, fr.t1, fr.t2, cone.dir, step.e.r, mode);
         if (mask.x == 0u && mask.y == 0u) {
             continue;
         }
         let weight = coverage_add(&cover, mask, mode);
         let lit = dot(s.normal, -cone.dir) > 0.0 && dot(s.normal, object.light) > 0.0;
         if (weight > 0.0 && lit) {
-            var sun = 1.0;
             if (object.shadows != 0u) {
-                sun = sun_visibility(e.c - s.normal * s.distance, s.normal, e.r, mode);
+                shadow = shadow_cone(step.e.c - s.normal * s.distance, s.normal, step.e.r);
+                sst = march_start(shadow);
+                scover = Coverage(vec2<u32>(0u, 0u), 0.0);
+                pending = s;
+                pending_weight = weight;
+                shadowing = true;
+                continue;
             }
-            color += weight * element_radiance(s, -cone.dir, sun);
+            color += weight * element_radiance(s, -cone.dir, 1.0);
         }
         if (coverage_full(cover, mode)) {
             break;
@@ -234,25 +292,11 @@ fn trace(cone: Cone, mode: u32) -> vec4<f32> {
     return vec4<f32>(color, coverage_share(cover, mode));
 }
 
-// ConeTracer::sun_visibility: the share of a shadow cone from the element's mean plane toward the
-// sun that nothing covers; it starts where an element of it clears that plane.
-fn sun_visibility(c: vec3<f32>, normal: vec3<f32>, r: f32, mode: u32) -> f32 {
+// ConeTracer::sun_visibility, its cone: from the element's mean plane toward the sun, starting
+// where an element of it clears that plane (trace marches it).
+fn shadow_cone(c: vec3<f32>, normal: vec3<f32>, r: f32) -> Cone {
     let light = object.light;
     let cs = max(dot(normal, light), 1.0 / 16.0);
     let start = r * (1.0 + sqrt(max(1.0 - cs * cs, 0.0)) / cs);
-    let shadow = Cone(c + light * start, light, r, 0.0, 0.0, 1.0);
-    let fr = orthonormal_pair(light);
-    var cover = Coverage(vec2<u32>(0u, 0u), 0.0);
-    var st = march_start(shadow);
-    loop {
-        let e = march_next(shadow, mode, &st);
-        if (!e.sample.found) {
-            break;
-        }
-        coverage_add(&cover, element_mask(e.sample, fr.t1, fr.t2, light, e.r, mode), mode);
-        if (coverage_full(cover, mode)) {
-            break;
-        }
-    }
-    return 1.0 - coverage_share(cover, mode);
+    return Cone(c + light * start, light, r, 0.0, 0.0, 1.0);
 }
