@@ -144,7 +144,7 @@ pub fn run(material: &Material, opts: &Options) -> Result<String> {
     let gpu_col = if gpu.is_some() { " / masks (GPU)" } else { "" };
     writeln!(
         text,
-        "| distance | across | covered / silhouette px | truth's s.e. (rays a covered pixel) | mean colour error: nearest / alpha / masks{gpu_col} | silhouette coverage error: nearest / alpha / masks{gpu_col} | µs a pixel: nearest / alpha / masks (CPU, one core){gpu_col} |"
+        "| distance | across | covered / silhouette px | truth's s.e. (rays a covered pixel) | mean colour error (+: brighter than the truth): nearest / alpha / masks{gpu_col} | silhouette coverage error: nearest / alpha / masks{gpu_col} | µs a pixel: nearest / alpha / masks (CPU, one core){gpu_col} |"
     )?;
     writeln!(text, "|---|---|---|---|---|---|---|")?;
     let mut rows = vec![];
@@ -189,7 +189,7 @@ pub fn run(material: &Material, opts: &Options) -> Result<String> {
             e.covered,
             e.silhouette,
             100.0 * e.truth_error,
-            col(&|m| format!("{:.2}%", 100.0 * m.mean_color_error)),
+            col(&|m| format!("{:+.2}%", 100.0 * m.mean_color_bias)),
             if e.silhouette == 0 {
                 "— (no silhouette in view)".to_string()
             } else {

@@ -1395,7 +1395,12 @@ fn object_refuses_bad_input_and_renders_a_small_sweep() {
             .map(str::trim)
             .collect();
         assert_eq!(colour.len(), 4, "{row}");
-        let pct = |s: &str| s.trim_end_matches('%').parse::<f64>().expect(s);
+        let pct = |s: &str| {
+            s.trim_end_matches('%')
+                .trim_start_matches('+')
+                .parse::<f64>()
+                .expect(s)
+        };
         // The GPU reads the f16-stored octree, the CPU the f64 one: within 0.1 points.
         assert!(
             (pct(colour[2]) - pct(colour[3])).abs() < 0.1,

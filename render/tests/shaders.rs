@@ -170,7 +170,6 @@ const MIRRORS: &[(&str, &str, &str, &str)] = &[
     ("object/cone_trace.wgsl", "coverage_full", "object/cone_trace.rs", "full"),
     ("object/cone_trace.wgsl", "march_start", "object/cone_trace.rs", "march"),
     ("object/cone_trace.wgsl", "march_step", "object/cone_trace.rs", "march"),
-    ("object/cone_trace.wgsl", "shadow_cone", "object/cone_trace.rs", "sun_visibility"),
     ("object/cone_trace.wgsl", "cone_radius", "object/cone_trace.rs", "radius"),
     ("object/shading.wgsl", "mean_attribute", "microfacet/attribute.rs", "mean_attribute"),
 ];

@@ -505,7 +505,7 @@ impl ObjectPanel {
                 .striped(true)
                 .show(ui, |ui| {
                     ui.label("");
-                    ui.label("mean colour error (covered)");
+                    ui.label("mean colour error (covered; +: brighter)");
                     ui.label("silhouette coverage error");
                     ui.end_row();
                     for (name, m) in ["nearest voxels", "alpha blended", "ours (masks)"]
@@ -513,7 +513,7 @@ impl ObjectPanel {
                         .zip(&e.modes)
                     {
                         ui.label(*name);
-                        ui.label(format!("{:.2}%", 100.0 * m.mean_color_error));
+                        ui.label(format!("{:+.2}%", 100.0 * m.mean_color_bias));
                         ui.label(if e.silhouette == 0 {
                             "—".into()
                         } else {

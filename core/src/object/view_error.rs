@@ -18,6 +18,8 @@ pub struct ModeErrors {
     pub mode: Compositing,
     /// Worst channel's relative error of the covered pixels' mean colour.
     pub mean_color_error: f64,
+    /// The same channel's error with its sign (positive: the view is brighter than the truth).
+    pub mean_color_bias: f64,
     /// RMSE of the covered pixels (luminance-free: all channels), over the truth's mean.
     pub relative_rmse: f64,
     /// Mean |coverage − truth's| over the silhouette pixels.
@@ -227,9 +229,10 @@ impl ObjectImages {
                         sq += (v[i].color[k] - truth_px[i].color[k]).powi(2);
                     }
                 }
-                let mean_color_error = (0..3)
-                    .map(|k| (sums[k] - sums_t[k]).abs() / sums_t[k].max(1e-300))
-                    .fold(0.0, f64::max);
+                let mean_color_bias = (0..3)
+                    .map(|k| (sums[k] - sums_t[k]) / sums_t[k].max(1e-300))
+                    .fold(0.0, |a: f64, b| if b.abs() > a.abs() { b } else { a });
+                let mean_color_error = mean_color_bias.abs();
                 let relative_rmse = (sq / (3.0 * covered.len().max(1) as f64)).sqrt() / mean_t;
                 let sil: Vec<usize> = (0..truth_px.len())
                     .filter(|&i| {
@@ -245,6 +248,7 @@ impl ObjectImages {
                 ModeErrors {
                     mode: *mode,
                     mean_color_error,
+                    mean_color_bias,
                     relative_rmse,
                     coverage_error,
                     seconds: *seconds,

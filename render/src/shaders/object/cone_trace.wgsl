@@ -1,8 +1,8 @@
 // Mirror of `core/src/object/cone_trace.rs` [HN12 Alg. 1]: a cone marched through the voxel field
 // in elements as long as they are wide, the level from the cone's radius, each element's sub-pixel
 // mask combined A-buffer style (or alpha blended [CNLE09], or nearest voxels as opaque blocks),
-// shadow cones toward the sun. Core's march visits elements through a closure; here `march_next`
-// returns them one at a time.
+// shadow cones toward the sun. Core's march visits elements through a closure; here `march_step`
+// takes one step at a time.
 
 const MODE_MASKS: u32 = 0u;
 const MODE_ALPHA_BLEND: u32 = 1u;
@@ -175,8 +175,9 @@ fn march_start(cone: Cone) -> MarchState {
 }
 
 // ConeTracer::march, one pass of its loop: the element at the state's distance, or a skip past
-// empty space (`sample.found` false); `done` once the span has ended. The caller's one loop calls
-// it (see trace).
+// empty space (`sample.found` false); `done` once the span has ended. trace and sun_visibility
+// call it once per pass of their loops (its own search for the next element would be a loop
+// inside theirs: more of the adapter's loop budget, bindings.wgsl).
 fn march_step(cone: Cone, mode: u32, st: ptr<function, MarchState>) -> Step {
     var out: Step;
     out.e.sample.found = false;
@@ -225,40 +226,13 @@ fn march_step(cone: Cone, mode: u32, st: ptr<function, MarchState>) -> Step {
     return out;
 }
 
-// ConeTracer::trace: a pixel's colour (rgb) and covered share (a). Core's trace visits the view
-// cone's elements and, inside that visit, marches each lit element's shadow cone; here one loop
-// runs both, a step of the view cone or of the shadow cone in flight per pass: the adapter's loop
-// budget (bindings.wgsl) counts a nested loop's passes for the slowest lane of the batch at every
-// pass of the outer loop, one loop only the slowest lane's steps.
+// ConeTracer::trace: a pixel's colour (rgb) and covered share (a).
 fn trace(cone: Cone, mode: u32) -> vec4<f32> {
     let fr = orthonormal_pair(cone.dir);
-    let lf = orthonormal_pair(object.light);
     var cover = Coverage(vec2<u32>(0u, 0u), 0.0);
     var color = vec3<f32>(0.0);
     var st = march_start(cone);
-    // The shadow cone in flight, its coverage, the element it decides and that element's weight.
-    var shadowing = false;
-    var shadow: Cone;
-    var sst: MarchState;
-    var scover: Coverage;
-    var pending: VoxelSample;
-    var pending_weight = 0.0;
     loop {
-        if (shadowing) {
-            let step = march_step(shadow, mode, &sst);
-            if (step.e.sample.found) {
-                coverage_add(&scover, element_mask(step.e.sample, lf.t1, lf.t2, object.light, step.e.r, mode), mode);
-            }
-            if (step.done || coverage_full(scover, mode)) {
-                let sun = 1.0 - coverage_share(scover, mode);
-                color += pending_weight * element_radiance(pending, -cone.dir, sun);
-                shadowing = false;
-                if (coverage_full(cover, mode)) {
-                    break;
-                }
-            }
-            continue;
-        }
         let step = march_step(cone, mode, &st);
         if (step.done) {
             break;
@@ -274,16 +248,11 @@ fn trace(cone: Cone, mode: u32) -> vec4<f32> {
         let weight = coverage_add(&cover, mask, mode);
         let lit = dot(s.normal, -cone.dir) > 0.0 && dot(s.normal, object.light) > 0.0;
         if (weight > 0.0 && lit) {
+            var sun = 1.0;
             if (object.shadows != 0u) {
-                shadow = shadow_cone(step.e.c - s.normal * s.distance, s.normal, step.e.r);
-                sst = march_start(shadow);
-                scover = Coverage(vec2<u32>(0u, 0u), 0.0);
-                pending = s;
-                pending_weight = weight;
-                shadowing = true;
-                continue;
+                sun = sun_visibility(step.e.c - s.normal * s.distance, s.normal, step.e.r, mode);
             }
-            color += weight * element_radiance(s, -cone.dir, 1.0);
+            color += weight * element_radiance(s, -cone.dir, sun);
         }
         if (coverage_full(cover, mode)) {
             break;
@@ -292,11 +261,27 @@ fn trace(cone: Cone, mode: u32) -> vec4<f32> {
     return vec4<f32>(color, coverage_share(cover, mode));
 }
 
-// ConeTracer::sun_visibility, its cone: from the element's mean plane toward the sun, starting
-// where an element of it clears that plane (trace marches it).
-fn shadow_cone(c: vec3<f32>, normal: vec3<f32>, r: f32) -> Cone {
+// ConeTracer::sun_visibility: the share of a shadow cone from the element's mean plane toward the
+// sun that nothing covers; it starts where an element of it clears that plane.
+fn sun_visibility(c: vec3<f32>, normal: vec3<f32>, r: f32, mode: u32) -> f32 {
     let light = object.light;
     let cs = max(dot(normal, light), 1.0 / 16.0);
     let start = r * (1.0 + sqrt(max(1.0 - cs * cs, 0.0)) / cs);
-    return Cone(c + light * start, light, r, 0.0, 0.0, 1.0);
+    let shadow = Cone(c + light * start, light, r, 0.0, 0.0, 1.0);
+    let fr = orthonormal_pair(light);
+    var cover = Coverage(vec2<u32>(0u, 0u), 0.0);
+    var st = march_start(shadow);
+    loop {
+        let step = march_step(shadow, mode, &st);
+        if (step.done) {
+            break;
+        }
+        if (step.e.sample.found) {
+            coverage_add(&cover, element_mask(step.e.sample, fr.t1, fr.t2, light, step.e.r, mode), mode);
+            if (coverage_full(cover, mode)) {
+                break;
+            }
+        }
+    }
+    return 1.0 - coverage_share(cover, mode);
 }
