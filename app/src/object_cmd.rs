@@ -8,7 +8,7 @@
 //! meshes and materials are usage errors (exit code 2).
 
 use crate::UsageError;
-use crate::object_scene::{GpuObject, ObjectScene, lighting, masks_shot};
+use crate::object_scene::{GpuObject, ObjectScene, masks_shot};
 use anyhow::{Context, Result};
 use lodestone_core::material::Material;
 use lodestone_core::material::colormap::linear_to_srgb;
@@ -17,6 +17,7 @@ use lodestone_core::object::cone_trace::{Compositing, ConePixel, ConeTracer};
 use lodestone_core::object::coverage_mask::MaskTable;
 use lodestone_core::object::mesh::TriMesh;
 use lodestone_core::object::object_truth::{Lens, ObjectTruth};
+use lodestone_core::object::shading::ObjectLighting;
 use lodestone_core::object::view_error::ObjectImages;
 use lodestone_core::scene::camera::Camera;
 use lodestone_core::scene::direction::direction;
@@ -98,7 +99,7 @@ pub fn run(material: &Material, opts: &Options) -> Result<String> {
     let color = |f: f64| scene.color(f);
     let (object, field, build) = (&scene.object, &scene.field, scene.build_seconds);
     let table = MaskTable::new();
-    let lighting = lighting(
+    let lighting = ObjectLighting::of_material(
         material,
         direction(opts.light.0.to_radians(), opts.light.1.to_radians()),
     );

@@ -4,7 +4,6 @@
 
 use crate::UsageError;
 use anyhow::{Context, Result};
-use glam::DVec3;
 use lodestone_core::eval::Evaluator;
 use lodestone_core::material::Material;
 use lodestone_core::object::base_shape::BaseShape;
@@ -64,16 +63,6 @@ impl ObjectScene {
     /// The driver value's colour (the truth's facets).
     pub fn color(&self, f: f64) -> [f64; 3] {
         self.ev.color_at(f)
-    }
-}
-
-/// The sun toward `light` with `material`'s strength, BRDF and masking correlation.
-pub fn lighting(material: &Material, light: DVec3) -> ObjectLighting {
-    ObjectLighting {
-        light,
-        sun: material.lighting.sun,
-        brdf: material.brdf.clone(),
-        correlation: material.filtering.correlation,
     }
 }
 

@@ -42,12 +42,10 @@ fn cone_traced_pixels_match_core() {
     let voxels = GpuVoxels::encode(&VoxelField::new(&tree));
     let field = voxels.decode();
     let table = MaskTable::new();
-    let lighting = ObjectLighting {
-        light: direction(37f64.to_radians(), (-37f64).to_radians()),
-        sun: material.lighting.sun,
-        brdf: material.brdf.clone(),
-        correlation: material.filtering.correlation,
-    };
+    let lighting = ObjectLighting::of_material(
+        &material,
+        direction(37f64.to_radians(), (-37f64).to_radians()),
+    );
     let view = ObjectView::new(&ctx);
     let octree = view.upload(&ctx, &voxels).unwrap();
     let (w, h) = (32u32, 24u32);
@@ -153,12 +151,10 @@ fn long_cones_fit_the_loop_budget() {
     let object = DisplacedObject::new(&material, shape).unwrap();
     let tree = VoxelOctree::of_object(&object, |f| ev.color_at(f), 7, 2.0, 1);
     let voxels = GpuVoxels::encode(&VoxelField::new(&tree));
-    let lighting = ObjectLighting {
-        light: direction(37f64.to_radians(), (-37f64).to_radians()),
-        sun: material.lighting.sun,
-        brdf: material.brdf.clone(),
-        correlation: material.filtering.correlation,
-    };
+    let lighting = ObjectLighting::of_material(
+        &material,
+        direction(37f64.to_radians(), (-37f64).to_radians()),
+    );
     let view = ObjectView::new(&ctx);
     let octree = view.upload(&ctx, &voxels).unwrap();
     let cam = camera(3.0);

@@ -8,7 +8,7 @@
 
 use super::view_state::ViewState;
 use crate::object_cmd;
-use crate::object_scene::{GpuObject, ObjectScene, lighting, masks_shot};
+use crate::object_scene::{GpuObject, ObjectScene, masks_shot};
 use glam::DVec3;
 use lodestone_core::material::Material;
 use lodestone_core::material::colormap::linear_to_srgb;
@@ -16,6 +16,7 @@ use lodestone_core::object::base_shape::BaseShape;
 use lodestone_core::object::cone_trace::{Compositing, ConePixel, ConeTracer};
 use lodestone_core::object::coverage_mask::MaskTable;
 use lodestone_core::object::object_truth::{Lens, ObjectTruth, pixel_cone};
+use lodestone_core::object::shading::ObjectLighting;
 use lodestone_core::object::view_error::{ObjectImages, ViewErrors};
 use lodestone_core::scene::camera::Camera;
 use std::path::PathBuf;
@@ -201,7 +202,7 @@ fn run(jobs: Receiver<Job>, shared: Arc<Mutex<Shared>>, repaint: impl Fn()) {
             continue;
         };
         if let Some(shot) = render {
-            let light = lighting(material, shot.light);
+            let light = ObjectLighting::of_material(material, shot.light);
             let started = std::time::Instant::now();
             let px = match gpu {
                 Some(g) => g
@@ -225,7 +226,7 @@ fn run(jobs: Receiver<Job>, shared: Arc<Mutex<Shared>>, repaint: impl Fn()) {
                 s.status = format!("Ground truth at {rays} rays a pixel…")
             });
             repaint();
-            let light = lighting(material, shot.light);
+            let light = ObjectLighting::of_material(material, shot.light);
             let color = |f: f64| sc.color(f);
             let truth = ObjectTruth {
                 object: &sc.object,

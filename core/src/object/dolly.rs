@@ -133,12 +133,8 @@ mod tests {
         let tree = VoxelOctree::of_object(&obj, |f| ev.color_at(f), depth, 4.0, 1);
         let field = VoxelField::new(&tree);
         let table = MaskTable::new();
-        let lighting = ObjectLighting {
-            light: glam::DVec3::new(0.4, -0.3, 0.8).normalize(),
-            sun: 1.0,
-            brdf: m.brdf.clone(),
-            correlation: m.filtering.correlation,
-        };
+        let lighting =
+            ObjectLighting::of_material(&m, glam::DVec3::new(0.4, -0.3, 0.8).normalize());
         body(&ConeTracer {
             field: &field,
             table: &table,

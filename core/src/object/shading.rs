@@ -34,6 +34,16 @@ fn local(v: DVec3, t: [DVec3; 2], n: DVec3) -> DVec3 {
 }
 
 impl ObjectLighting {
+    /// The sun toward unit `light` with `material`'s strength, base BRDF and masking correlation.
+    pub fn of_material(material: &crate::material::Material, light: DVec3) -> Self {
+        Self {
+            light,
+            sun: material.lighting.sun,
+            brdf: material.brdf.clone(),
+            correlation: material.filtering.correlation,
+        }
+    }
+
     /// The radiance toward `wo` of an explicit facet of normal n and colour c, on a surface whose
     /// macro normal there is m, with the sun visible (`lit`) or not.
     pub fn facet_radiance(
