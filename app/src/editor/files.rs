@@ -201,7 +201,8 @@ impl EditorApp {
     }
 
     /// Files dropped on the window: a `.ron` opens (asking first), an `.hdr`/`.exr` becomes the
-    /// environment and a `.binary` (MERL) the measured base BRDF (undoable edits).
+    /// environment and a `.binary` (MERL) the measured base BRDF (undoable edits); an `.obj` mesh
+    /// opens in the Object window, voxelised with the current material.
     pub(super) fn handle_drops(&mut self, ctx: &egui::Context) {
         let dropped: Vec<PathBuf> = ctx.input(|i| {
             i.raw
@@ -215,7 +216,9 @@ impl EditorApp {
             let ext = p
                 .extension()
                 .map(|e| e.to_string_lossy().to_ascii_lowercase());
-            if ext.as_deref() == Some("binary") {
+            if ext.as_deref() == Some("obj") {
+                self.object.open_mesh(ctx, p, self.doc.material.clone());
+            } else if ext.as_deref() == Some("binary") {
                 // A MERL measured BRDF: the base BRDF becomes that file (an undoable edit).
                 let path = self.relative_to_preset(&p);
                 self.doc.material.brdf.measured = Some(path.clone());

@@ -385,6 +385,24 @@ impl ObjectPanel {
         self.send(ctx, Job::Build(Box::new((material, shape, self.depth))));
     }
 
+    /// Opens the window on the OBJ mesh at `path` (a dropped file) and builds it from `material`;
+    /// a bad mesh is reported in the window's status (the shape stays a mesh to choose again).
+    pub fn open_mesh(&mut self, ctx: &egui::Context, path: PathBuf, material: Material) {
+        self.open = true;
+        self.shape = ShapeKind::Mesh;
+        self.mesh = Some(path);
+        self.build(ctx, material);
+    }
+
+    /// The window's status line (tests).
+    #[cfg(test)]
+    pub fn status(&self) -> String {
+        self.shared
+            .lock()
+            .map(|s| s.status.clone())
+            .unwrap_or_default()
+    }
+
     fn shot(&self, view: &ViewState) -> Shot {
         Shot {
             camera: Camera {

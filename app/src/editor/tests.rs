@@ -53,6 +53,19 @@ fn settle(h: &mut Harness<'static, EditorApp>, timeout: Duration) {
     panic!("the editor did not settle in {timeout:?}");
 }
 
+/// A file dropped on the window (kittest has no file drops of its own).
+#[derive(Debug)]
+struct Dropped(PathBuf);
+
+impl egui::DroppedFile for Dropped {
+    fn path(&self) -> &Path {
+        &self.0
+    }
+    fn bytes(&self) -> Result<Vec<u8>, String> {
+        std::fs::read(&self.0).map_err(|e| e.to_string())
+    }
+}
+
 /// Where the window baselines live, with `adapter.txt`: the adapter they were rendered on.
 fn snapshot_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots")
@@ -700,6 +713,48 @@ fn object_window_builds_renders_and_compares() {
     h.get_by_label("ground truth");
 }
 
+/// An OBJ dropped on the window opens the Object window on it, voxelised with the current
+/// material; a mesh that is not closed is refused in the window's status, naming the fault.
+#[test]
+fn dropping_a_mesh_opens_it_in_the_object_window() {
+    let dir = std::env::temp_dir().join(format!("lodestone-drop-obj-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let open = dir.join("open.obj");
+    std::fs::write(
+        &open,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\n",
+    )
+    .unwrap();
+    let cube = Path::new(env!("CARGO_MANIFEST_DIR")).join("../presets/meshes/cube.obj");
+    let mut h = harness(1400.0, 900.0, DeviceSource::Unavailable);
+    h.state_mut().object.set_budget(4, 8, 8.0);
+    h.step();
+    h.input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped(cube)));
+    h.step();
+    assert!(h.state().object.open, "the window opens");
+    let t0 = Instant::now();
+    while (h.state().object.busy() || h.state().object.results().0.is_none())
+        && t0.elapsed() < Duration::from_secs(300)
+    {
+        h.step();
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let cover = h.state().object.results().0.expect("the cube's voxel view");
+    assert!(cover > 0.01, "{cover}");
+    h.input_mut()
+        .dropped_files
+        .push(std::sync::Arc::new(Dropped(open.clone())));
+    h.step();
+    let status = h.state().object.status();
+    assert!(
+        status.contains("open.obj") && status.contains("not closed"),
+        "{status}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// Regenerates `screenshots/app/object-window-d*.png`: the Object window on the default preset at
 /// three distances (the voxel view, then its comparison with the ground truth). Ignored by
 /// default: `cargo test --release -p lodestone -- --ignored regenerate_object_screenshots`.
@@ -886,16 +941,6 @@ fn dropping_an_environment_map_sets_the_environment() {
     let mut h = harness(1200.0, 800.0, DeviceSource::Unavailable);
     h.step();
     assert!(h.state().material().lighting.environment.is_none());
-    #[derive(Debug)]
-    struct Dropped(std::path::PathBuf);
-    impl egui::DroppedFile for Dropped {
-        fn path(&self) -> &std::path::Path {
-            &self.0
-        }
-        fn bytes(&self) -> Result<Vec<u8>, String> {
-            std::fs::read(&self.0).map_err(|e| e.to_string())
-        }
-    }
     h.input_mut()
         .dropped_files
         .push(std::sync::Arc::new(Dropped("/tmp/studio.hdr".into())));
@@ -933,16 +978,6 @@ fn dropping_a_measured_brdf_loads_it_and_shows_its_fit() {
     .unwrap();
     let bad = dir.join("short.binary");
     std::fs::write(&bad, [0u8; 100]).unwrap();
-    #[derive(Debug)]
-    struct Dropped(std::path::PathBuf);
-    impl egui::DroppedFile for Dropped {
-        fn path(&self) -> &std::path::Path {
-            &self.0
-        }
-        fn bytes(&self) -> Result<Vec<u8>, String> {
-            std::fs::read(&self.0).map_err(|e| e.to_string())
-        }
-    }
     let mut h = harness(1400.0, 900.0, DeviceSource::Unavailable);
     h.step();
     h.input_mut()
