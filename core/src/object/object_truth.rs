@@ -74,9 +74,8 @@ impl ObjectTruth<'_> {
             hits += 1;
             let c = (self.color)(self.object.value(hit.p));
             let nrm = self.object.normal(hit.p);
-            let m = self.object.shape.normal(hit.p);
             let lit = !self.shadows || self.object.sees(hit.p, self.lighting.light);
-            let l = self.lighting.facet_radiance(c, nrm, m, -d, lit);
+            let l = self.lighting.facet_radiance(c, nrm, -d, lit);
             for k in 0..3 {
                 out.color[k] += l[k] / n as f64;
                 squares[k] += l[k] * l[k] / n as f64;

@@ -3,10 +3,16 @@
 //! analytic base BRDF and its colour map of the driver's value. (Environment light, slope colour
 //! and measured BRDFs are the plane's; objects do not take them yet.)
 //!
-//! Both evaluate the specular lobe in slope space relative to a local frame whose z is the
-//! macro-surface's normal, as the plane's views do in the plane's frame: the base normal at the hit
-//! for a facet ([`crate::microfacet::brdf::BaseBrdf::specular_with`]), the voxel's mean normal n̄ for
-//! its statistics ([`crate::microfacet::brdf::filtered_specular`] over its slope covariance).
+//! Both evaluate the specular lobe in slope space relative to a local frame: an explicit facet in
+//! its own frame (the base lobe of roughness σ_n0 about the facet's normal,
+//! [`crate::microfacet::brdf::BaseBrdf::specular_with`] with n = z), a voxel in the frame of its
+//! mean normal n̄ with the lobe widened by its slopes
+//! ([`crate::microfacet::brdf::filtered_specular`]): where a voxel resolves the relief (n̄ follows
+//! the facets, small slope covariance) the two are the same lobe, and over many facets the widened
+//! lobe is their average to first order [HN12 Sec. 5.5]. (The lobe in the frame of the undisplaced
+//! base normal, the plane's convention carried over, was measured and dropped: its
+//! `1/(4 h_z⁴ ωo_z)` with ωo_z taken to the base normal made the truth's specular of infinite
+//! variance near base silhouettes, and left the voxels 5–12% darker than it on a torus seen at 60°.)
 
 use crate::microfacet::attribute::mean_attribute;
 use crate::microfacet::brdf::{BaseBrdf, filtered_specular};
@@ -44,26 +50,20 @@ impl ObjectLighting {
         }
     }
 
-    /// The radiance toward `wo` of an explicit facet of normal n and colour c, on a surface whose
-    /// macro normal there is m, with the sun visible (`lit`) or not.
-    pub fn facet_radiance(
-        &self,
-        c: [f64; 3],
-        n: DVec3,
-        m: DVec3,
-        wo: DVec3,
-        lit: bool,
-    ) -> [f64; 3] {
+    /// The radiance toward `wo` of an explicit facet of unit normal n and colour c, with the sun
+    /// visible (`lit`) or not: Lambert's diffuse and the base lobe about n (module docs). 0 when
+    /// the sun or the eye is behind the facet.
+    pub fn facet_radiance(&self, c: [f64; 3], n: DVec3, wo: DVec3, lit: bool) -> [f64; 3] {
         if !lit || n.dot(self.light) <= 0.0 {
             return [0.0; 3];
         }
         let diffuse = self.brdf.diffuse(n, self.light);
-        let (t1, t2) = m.any_orthonormal_pair();
+        let (t1, t2) = n.any_orthonormal_pair();
         let t = [t1, t2];
         let spec = self.brdf.specular_with(
-            local(n, t, m),
-            local(wo, t, m),
-            local(self.light, t, m),
+            DVec3::Z,
+            local(wo, t, n),
+            local(self.light, t, n),
             Default::default(),
         );
         c.map(|ck| self.sun * (diffuse * ck + spec))
