@@ -662,6 +662,24 @@ fn report_window_runs_and_cancels() {
     h.get_by_label("Run");
 }
 
+/// `lodestone object`'s camera (60°, azimuth 30°) and sun (37°, azimuth −37°) in the editor.
+fn object_command_view(h: &mut Harness<'static, EditorApp>) {
+    let v = &mut h.state_mut().view;
+    v.camera.elevation_deg = 60.0;
+    v.camera.azimuth_deg = 30.0;
+    v.light_elevation_deg = 37.0;
+    v.light_azimuth_deg = -37.0;
+}
+
+/// Steps the harness until `done` holds or `secs` pass.
+fn wait_until(h: &mut Harness<'static, EditorApp>, secs: u64, done: &dyn Fn(&EditorApp) -> bool) {
+    let t0 = Instant::now();
+    while !done(h.state()) && t0.elapsed() < Duration::from_secs(secs) {
+        h.step();
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
 /// The Object window: Build voxelises a sphere on its thread, the voxel view comes back (from the
 /// adapter, or the CPU without one), and the comparison with the ground truth gives the errors the
 /// command prints: ours within 5% in colour and closer at the silhouette than alpha blending.
@@ -672,20 +690,10 @@ fn object_window_builds_renders_and_compares() {
     h.state_mut().object.set_budget(4, 16, 4.0);
     // `lodestone object`'s camera and sun (the truth's facets at the silhouette under the
     // editor's default light are glints 16 rays do not resolve).
-    h.state_mut().view.camera.elevation_deg = 60.0;
-    h.state_mut().view.camera.azimuth_deg = 30.0;
-    h.state_mut().view.light_elevation_deg = 37.0;
-    h.state_mut().view.light_azimuth_deg = -37.0;
+    object_command_view(&mut h);
     h.run_steps(2);
     h.get_by_label("Build").click();
-    let wait = |h: &mut Harness<'static, EditorApp>, done: &dyn Fn(&EditorApp) -> bool| {
-        let t0 = Instant::now();
-        while !done(h.state()) && t0.elapsed() < Duration::from_secs(300) {
-            h.step();
-            std::thread::sleep(Duration::from_millis(50));
-        }
-    };
-    wait(&mut h, &|a| {
+    wait_until(&mut h, 300, &|a| {
         !a.object.busy() && a.object.results().0.is_some()
     });
     let (cover, _) = h.state().object.results();
@@ -696,7 +704,7 @@ fn object_window_builds_renders_and_compares() {
     );
     h.get_by_label("Compare with ground truth").click();
     h.run_steps(2);
-    wait(&mut h, &|a| {
+    wait_until(&mut h, 300, &|a| {
         !a.object.busy() && a.object.results().1.is_some()
     });
     let e = h
@@ -734,13 +742,9 @@ fn dropping_a_mesh_opens_it_in_the_object_window() {
         .push(std::sync::Arc::new(Dropped(cube)));
     h.step();
     assert!(h.state().object.open, "the window opens");
-    let t0 = Instant::now();
-    while (h.state().object.busy() || h.state().object.results().0.is_none())
-        && t0.elapsed() < Duration::from_secs(300)
-    {
-        h.step();
-        std::thread::sleep(Duration::from_millis(50));
-    }
+    wait_until(&mut h, 300, &|a| {
+        !a.object.busy() && a.object.results().0.is_some()
+    });
     let cover = h.state().object.results().0.expect("the cube's voxel view");
     assert!(cover > 0.01, "{cover}");
     h.input_mut()
@@ -764,10 +768,7 @@ fn regenerate_object_screenshots() {
     let mut h = harness(1600.0, 900.0, DeviceSource::Headless);
     h.state_mut().object.open = true;
     h.state_mut().object.set_budget(7, 64, 8.0);
-    h.state_mut().view.camera.elevation_deg = 60.0;
-    h.state_mut().view.camera.azimuth_deg = 30.0;
-    h.state_mut().view.light_elevation_deg = 37.0;
-    h.state_mut().view.light_azimuth_deg = -37.0;
+    object_command_view(&mut h);
     h.run_steps(2);
     h.get_by_label("Build").click();
     for distance in [8.0, 4.0, 2.0] {

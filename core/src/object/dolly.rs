@@ -116,15 +116,7 @@ mod tests {
     use crate::object::shading::ObjectLighting;
     use crate::object::voxel_field::VoxelField;
 
-    fn camera(distance: f64) -> Camera {
-        Camera {
-            elevation_deg: 60.0,
-            azimuth_deg: 30.0,
-            distance,
-            target: [0.0, 0.0],
-            fov_deg: 30.0,
-        }
-    }
+    use crate::object::test_camera as camera;
 
     fn with_tracer<R>(depth: u32, body: impl FnOnce(&ConeTracer) -> R) -> R {
         let m = Material::default();

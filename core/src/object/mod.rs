@@ -20,6 +20,19 @@ pub mod view_error;
 pub mod voxel_field;
 pub mod voxel_stats;
 
+/// The camera of the module's tests: 60° from the pole, azimuth 30°, a 30° field of view, looking
+/// at the origin from `distance`.
+#[cfg(test)]
+pub(crate) fn test_camera(distance: f64) -> crate::scene::camera::Camera {
+    crate::scene::camera::Camera {
+        elevation_deg: 60.0,
+        azimuth_deg: 30.0,
+        distance,
+        target: [0.0, 0.0],
+        fov_deg: 30.0,
+    }
+}
+
 /// The central-difference gradient of `f` at p with step e (for the module's tests).
 #[cfg(test)]
 pub(crate) fn central_gradient(

@@ -355,15 +355,7 @@ mod tests {
         Compositing::Masks,
     ];
 
-    fn camera(distance: f64) -> Camera {
-        Camera {
-            elevation_deg: 60.0,
-            azimuth_deg: 30.0,
-            distance,
-            target: [0.0, 0.0],
-            fov_deg: 30.0,
-        }
-    }
+    use crate::object::test_camera as camera;
 
     /// HN12's two claims in test size (octree depth 5, 20 × 15 pixels, 16 rays a pixel, distance
     /// 6): the masks' silhouette coverage error at least 3× below alpha blending's and nearest
