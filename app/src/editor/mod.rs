@@ -248,7 +248,7 @@ impl EditorApp {
             view_px: [0, 0],
             plots: AnglePlots::default(),
             report: report_panel::ReportPanel::default(),
-            object: object_panel::ObjectPanel::default(),
+            object: object_panel::ObjectPanel::on(device_source),
             notice,
             pending: None,
             frame_times: VecDeque::new(),

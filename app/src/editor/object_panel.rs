@@ -7,6 +7,7 @@
 //! prints).
 
 use super::view_state::ViewState;
+use super::worker::DeviceSource;
 use crate::object_cmd;
 use crate::object_scene::{GpuObject, ObjectScene, masks_shot};
 use glam::DVec3;
@@ -103,6 +104,8 @@ pub struct ObjectPanel {
     seen: u64,
     textures: Vec<(String, egui::TextureHandle)>,
     thread: Option<std::thread::JoinHandle<()>>,
+    /// Whether the voxel view may take a GPU device (the editor's choice; none: the CPU tracer).
+    device: DeviceSource,
 }
 
 impl Default for ObjectPanel {
@@ -124,6 +127,7 @@ impl Default for ObjectPanel {
             seen: 0,
             textures: vec![],
             thread: None,
+            device: DeviceSource::Headless,
         }
     }
 }
@@ -151,7 +155,7 @@ fn set(shared: &Mutex<Shared>, f: impl FnOnce(&mut Shared)) {
 }
 
 /// The background thread: builds, renders, compares; later jobs of a kind replace earlier ones.
-fn run(jobs: Receiver<Job>, shared: Arc<Mutex<Shared>>, repaint: impl Fn()) {
+fn run(jobs: Receiver<Job>, shared: Arc<Mutex<Shared>>, device: DeviceSource, repaint: impl Fn()) {
     super::priority::lower_current_thread();
     let mut scene: Option<(ObjectScene, Material, Option<GpuObject>)> = None;
     let table = MaskTable::new();
@@ -174,9 +178,12 @@ fn run(jobs: Receiver<Job>, shared: Arc<Mutex<Shared>>, repaint: impl Fn()) {
             scene = None;
             match ObjectScene::build(&material, shape, depth) {
                 Ok(sc) => {
-                    let gpu = GpuObject::new(&sc.field)
-                        .inspect_err(|e| log::warn!("object view on the CPU: {e:#}"))
-                        .ok();
+                    let gpu = (device == DeviceSource::Headless)
+                        .then(|| GpuObject::new(&sc.field))
+                        .and_then(|g| {
+                            g.inspect_err(|e| log::warn!("object view on the CPU: {e:#}"))
+                                .ok()
+                        });
                     let mib = sc.memory.iter().map(|l| l.gpu_bytes).sum::<usize>() as f64
                         / f64::from(1 << 20);
                     let status = format!(
@@ -324,6 +331,13 @@ fn color_image(w: u32, h: u32, px: &[ConePixel]) -> egui::ColorImage {
 }
 
 impl ObjectPanel {
+    /// The window with the editor's device choice: without one the voxel view is the CPU tracer's.
+    pub fn on(device: DeviceSource) -> Self {
+        let mut panel = Self::default();
+        panel.device = device;
+        panel
+    }
+
     /// Sets the octree depth, truth rays and distance (tests and screenshots).
     #[cfg(test)]
     pub fn set_budget(&mut self, depth: u32, rays: u32, distance: f64) {
@@ -356,9 +370,10 @@ impl ObjectPanel {
             let (tx, rx) = channel();
             let shared = self.shared.clone();
             let c = ctx.clone();
+            let device = self.device;
             self.thread = std::thread::Builder::new()
                 .name("lodestone-object".into())
-                .spawn(move || run(rx, shared, move || c.request_repaint()))
+                .spawn(move || run(rx, shared, device, move || c.request_repaint()))
                 .inspect_err(|e| log::error!("the object thread: {e}"))
                 .ok();
             self.jobs = Some(tx);
