@@ -112,7 +112,7 @@ impl Camera {
 
     /// Unnormalised direction through continuous pixel coordinates (x right, y down, pixel centres at
     /// +0.5) of a `width × height` image.
-    pub(crate) fn raw_dir(&self, p: DVec2, width: u32, height: u32) -> DVec3 {
+    pub fn raw_dir(&self, p: DVec2, width: u32, height: u32) -> DVec3 {
         let (r, u, f) = self.basis();
         let t = self.tan_half_fov();
         let aspect = f64::from(width) / f64::from(height.max(1));
@@ -122,7 +122,7 @@ impl Camera {
     }
 
     /// Change of the unnormalised ray direction per pixel in x and in y.
-    pub(crate) fn pixel_steps(&self, width: u32, height: u32) -> (DVec3, DVec3) {
+    pub fn pixel_steps(&self, width: u32, height: u32) -> (DVec3, DVec3) {
         let (r, u, _) = self.basis();
         let t = self.tan_half_fov();
         let aspect = f64::from(width) / f64::from(height.max(1));

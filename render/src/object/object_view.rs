@@ -20,10 +20,9 @@ use lodestone_core::material::features::{Feature, FeatureSet};
 use lodestone_core::microfacet::masking_shadowing::Correlation;
 use lodestone_core::object::cone_trace::Compositing;
 use lodestone_core::object::coverage_mask::MaskTable;
-use lodestone_core::object::object_truth::Lens;
+use lodestone_core::object::object_truth::{Lens, pixel_cone};
 use lodestone_core::object::shading::ObjectLighting;
 use lodestone_core::scene::camera::Camera;
-use std::f64::consts::PI;
 use wgpu::util::DeviceExt;
 
 /// The features the object shader is specialised to.
@@ -209,18 +208,17 @@ impl ObjectView {
             });
         }
         let cam = shot.camera;
-        let (r, u, f) = cam.basis();
-        let t = cam.tan_half_fov();
-        let aspect = f64::from(w) / f64::from(h);
+        // The camera's own affine map from pixel coordinates to ray directions, and core's cone.
+        let (step_x, step_y) = cam.pixel_steps(w, h);
         let l = shot.lighting;
         let params = ObjectParams {
             eye: v3(cam.eye()),
             half: octree.half as f32,
-            dir00: v3(f - r * (t * aspect) + u * t),
-            spread: (2.0 * t / f64::from(h) / PI.sqrt()) as f32,
-            step_x: v3(r * (2.0 * t * aspect / f64::from(w))),
+            dir00: v3(cam.raw_dir(glam::DVec2::ZERO, w, h)),
+            spread: pixel_cone(cam, 0.5, 0.5, w, h).spread as f32,
+            step_x: v3(step_x),
             width: w,
-            step_y: v3(u * (-2.0 * t / f64::from(h))),
+            step_y: v3(step_y),
             height: h,
             light: v3(l.light),
             sun: l.sun as f32,
