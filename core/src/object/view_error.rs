@@ -421,8 +421,7 @@ mod tests {
     /// covered pixels than through a pinhole: measured 141 against 51) and the wider cones follow
     /// it, the masks' coverage error 0.10 (alpha blending 0.24; through the pinhole 0.05 and 0.25),
     /// the covered pixels' colour +6.9% (pinhole +5.3%: the cones read levels 3–4 of this depth-5
-    /// octree, whose voxels hold whole bumps, and their widened lobe is the facets' lobes' average
-    /// to first order only).
+    /// octree, whose voxels hold whole bumps, where HN12's diffuse `(l·n̄)·V̄(l)` reads bright).
     #[test]
     fn wider_cones_follow_the_lens() {
         with_scene(5, |_, truth, tracer| {
