@@ -218,6 +218,7 @@ const GPU_ONLY: &[(&str, &str, &str)] = &[
     ("object/voxel_field.wgsl", "voxel_corner", "one corner of sample_level (its loop body, written out eight times)"),
     ("object/cone_trace.wgsl", "bisect_empty", "one bisection step of skip (its loop body, written out four times)"),
     ("object/cone_trace.wgsl", "axis_slab", "one axis of cube_span and box_exit (their loop body, written out three times)"),
+    ("object/shading.wgsl", "visible_cosine_node", "one node of visible_cosine (its loop body, the inner axis written out)"),
     ("object/shading.wgsl", "object_local", "a vector in the element's frame (shading.rs local)"),
     ("object_view.wgsl", "object_two", "2, as a value the shader compiler cannot fold (note_budget)"),
     ("object_view.wgsl", "object_main", "the compute entry point"),

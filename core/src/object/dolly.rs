@@ -156,8 +156,8 @@ mod tests {
     }
 
     /// Over one octave of cone radius in 24 steps (every pixel crosses one level boundary), each
-    /// covered pixel's colour under the masks changes evenly (mean jump ratio 2.97, bound 4; a
-    /// level switch in one step would read up to 24), nearest voxels' in jumps (6.74, more than
+    /// covered pixel's colour under the masks changes evenly (mean jump ratio 2.94, bound 4; a
+    /// level switch in one step would read up to 24), nearest voxels' in jumps (6.70, more than
     /// twice). With the levels rounded instead of blended the masks read 4.71 and the bound fails.
     #[test]
     fn masks_blend_levels_without_popping() {
