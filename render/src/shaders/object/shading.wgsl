@@ -33,9 +33,10 @@ fn mean_attribute(mean: vec3<f32>, correlation: vec3<f32>, l: f32) -> vec3<f32> 
 // (n·ωo)⁺/n_z, on the 4 × 4 Gauss–Hermite rule VC_X, VC_W (from core). The inner axis written
 // out (the loop budget, bindings.wgsl).
 fn visible_cosine(cov: vec3<f32>, wo: vec3<f32>, wi: vec3<f32>) -> f32 {
-    let l11 = sqrt(max(cov.x, 0.0));
-    let l21 = select(0.0, cov.z / l11, l11 > 0.0);
-    let l22 = sqrt(max(cov.y - l21 * l21, 0.0));
+    let l = cholesky(cov);
+    let l11 = l.x;
+    let l21 = l.y;
+    let l22 = l.z;
     var acc = vec2<f32>(0.0);
     for (var i = 0u; i < 4u; i = i + 1u) {
         let a = VC_X[i];
