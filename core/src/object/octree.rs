@@ -88,12 +88,9 @@ impl VoxelOctree {
         let depth = depth.min(MAX_DEPTH);
         let half = object.bounding_radius() * 1.001;
         let size = 2.0 * half / f64::from(1u32 << depth);
-        // n² samples over an area A put A/n² on each; a voxel's face holds about size² of it.
-        let n = ((per_voxel.max(1.0) * object.shape.area() / (size * size))
-            .sqrt()
-            .ceil() as usize)
-            .clamp(8, 8192);
-        Self::from_samples(&object.surface_samples(n, seed), color, half, depth)
+        // Lines `spacing` apart cross a voxel's face (size²) about size²/spacing² times per grid.
+        let spacing = size / per_voxel.clamp(1.0, 64.0).sqrt();
+        Self::from_samples(&object.surface_samples(spacing, seed), color, half, depth)
     }
 
     /// The deepest level.
@@ -170,10 +167,10 @@ mod tests {
     #[test]
     fn every_level_holds_the_statistics_of_its_surface() {
         let (obj, color) = object();
-        let samples = obj.surface_samples(200, 1);
+        let samples = obj.surface_samples(0.02, 1);
         let sample_area = samples.iter().map(|s| s.area).sum::<f64>() / samples.len() as f64;
         let tree = VoxelOctree::from_samples(&samples, &color, obj.bounding_radius(), 4);
-        let dense = obj.surface_samples(500, 99);
+        let dense = obj.surface_samples(0.008, 99);
         let mut checked = 0;
         for level in 1..=tree.depth() - 1 {
             let mut keys: Vec<_> = tree.levels[level as usize].keys().copied().collect();

@@ -1,15 +1,18 @@
 //! Area-weighted samples of a displaced object's surface (#19): what the voxel octree's statistics
 //! are summed from, and what tests measure those statistics against.
 //!
-//! The base surface is spread with `n × n` points ([`BaseShape::surface_points`]: jittered
-//! parameter cells, or a mesh's triangles by area). Each base point b with normal m is carried to the
-//! displaced surface by tracing from `b + (reach + margin)·m` back along −m
-//! ([`DisplacedObject::trace`]: the outermost crossing, the point a ray along the normal sees).
-//! Its area is the base cell's times the displaced surface's area element, `|∇F|/(m·∇F)` (the
-//! height-field element `√(1 + |∇h|²)` for a displacement along m; the base's own curvature
-//! factor `1 + κh` is left out: O(σ_h/R), 2% at the relief's limit of a quarter radius).
-//! Cells whose trace finds nothing (none on a valid object) are dropped. The traces run in parallel
-//! (rayon); the samples keep the base points' order.
+//! The surface `F = 0` is sampled where the lines of three orthogonal grids cross it (Cauchy–
+//! Crofton): lines parallel to each axis a, one per `spacing × spacing` cell of the plane across a
+//! (jittered within its cell), over the object's bounding sphere. A patch of area dA with unit
+//! normal n is crossed by `dA·|n_a|/spacing²` lines of grid a on average, so a crossing of grid a
+//! weighted `spacing²·|n_a|` makes the three grids' sum unbiased for any n (`Σ_a n_a² = 1`), with
+//! bounded weights (no `1/|n_a|`). Every crossing along a line is found, into the object and out of
+//! it ([`DisplacedObject::crossings`]), so every sheet of the surface is sampled, whatever its shape:
+//! the rounded wedge the relief raises over a mesh's convex edge and the folds where two faces'
+//! reliefs meet over a concave one, which a trace along the base normal from each base point
+//! (this module's first version) left out or counted twice (a displaced cube read 33% dark along
+//! its edges). No parametrisation of the base surface is needed and none of its curvature is left
+//! out. The lines run in parallel (rayon); the samples keep the lines' order.
 
 use crate::object::displaced::DisplacedObject;
 use glam::DVec3;
@@ -30,24 +33,48 @@ pub struct SurfaceSample {
 }
 
 impl DisplacedObject {
-    /// `n × n` samples of the surface (module docs), jittered with `seed`.
-    pub fn surface_samples(&self, n: usize, seed: u64) -> Vec<SurfaceSample> {
+    /// The surface's crossings with three orthogonal grids of lines `spacing` apart (module
+    /// docs), jittered with `seed`: about `area/spacing²·E[Σ|n_a|]` samples (1 to 1.7 per
+    /// `spacing²` of surface). A spacing that is not positive and finite gives no samples.
+    pub fn surface_samples(&self, spacing: f64, seed: u64) -> Vec<SurfaceSample> {
+        use crate::math::random::splitmix;
         use rayon::prelude::*;
-        let reach = self.surface.h_max + 1e-3 * self.shape.bounding_radius();
-        self.shape
-            .surface_points(n, seed)
+        if !(spacing > 0.0 && spacing.is_finite()) {
+            return Vec::new();
+        }
+        // Segments start and end a spacing clear of the surface (which may touch the bounding
+        // sphere: a sphere without relief).
+        let r = self.bounding_radius() + spacing;
+        let cells = ((2.0 * r / spacing).ceil() as usize).max(1);
+        let per_axis = cells * cells;
+        (0..3 * per_axis)
             .into_par_iter()
-            .filter_map(|(b, base_area)| {
-                let m = self.shape.normal(b);
-                let hit = self.trace(b + m * reach, -m)?;
-                let grad = self.gap_gradient(hit.p);
-                let cosine = m.dot(grad);
-                (cosine > 1e-6).then(|| SurfaceSample {
-                    p: hit.p,
-                    n: grad.normalize(),
-                    m,
-                    area: base_area * grad.length() / cosine,
-                    f: self.value(hit.p),
+            .flat_map_iter(|line| {
+                let axis = line / per_axis;
+                let (i, j) = (line % per_axis % cells, line % per_axis / cells);
+                let mut rng = seed ^ (line as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+                let u = -r + (i as f64 + splitmix(&mut rng)) * spacing;
+                let v = -r + (j as f64 + splitmix(&mut rng)) * spacing;
+                let half_chord = (r * r - u * u - v * v).max(0.0).sqrt();
+                let (d, across) = match axis {
+                    0 => (DVec3::X, DVec3::new(0.0, u, v)),
+                    1 => (DVec3::Y, DVec3::new(v, 0.0, u)),
+                    _ => (DVec3::Z, DVec3::new(u, v, 0.0)),
+                };
+                let hits = if half_chord > 0.0 {
+                    self.crossings(across - d * half_chord, d, 2.0 * half_chord)
+                } else {
+                    Vec::new()
+                };
+                hits.into_iter().map(move |p| {
+                    let n = self.normal(p);
+                    SurfaceSample {
+                        p,
+                        n,
+                        m: self.shape.normal(p),
+                        area: spacing * spacing * n[axis].abs(),
+                        f: self.value(p),
+                    }
                 })
             })
             .collect()
@@ -59,6 +86,43 @@ mod tests {
     use super::*;
     use crate::material::Material;
     use crate::object::base_shape::BaseShape;
+    use crate::object::mesh::TriMesh;
+    use std::sync::Arc;
+
+    fn bumpy(shape: BaseShape) -> DisplacedObject {
+        let mut m = Material::default();
+        m.heights.sigma_h = 0.02;
+        m.slopes.sigma_nx = 0.25;
+        m.slopes.sigma_ny = 0.25;
+        DisplacedObject::new(&m, shape).unwrap()
+    }
+
+    /// A cube of side 2 as an OBJ mesh.
+    fn cube() -> BaseShape {
+        let mut obj = String::new();
+        for z in [-1, 1] {
+            for y in [-1, 1] {
+                for x in [-1, 1] {
+                    obj += &format!("v {x} {y} {z}\n");
+                }
+            }
+        }
+        // Vertex k = 1 + x + 2y + 4z (bits); faces counter-clockwise from outside.
+        for f in [
+            [1, 3, 4, 2],
+            [5, 6, 8, 7],
+            [1, 2, 6, 5],
+            [3, 7, 8, 4],
+            [1, 5, 7, 3],
+            [2, 4, 8, 6],
+        ] {
+            obj += &format!(
+                "f {} {} {}\nf {} {} {}\n",
+                f[0], f[1], f[2], f[0], f[2], f[3]
+            );
+        }
+        BaseShape::Mesh(Arc::new(TriMesh::from_obj(&obj).unwrap()))
+    }
 
     /// The samples lie on the surface, their normals are the surface's, and their areas add up to
     /// the base's area when the relief is flat and to more (the relief's area element, 1 + σ²/2 to
@@ -71,23 +135,21 @@ mod tests {
                 major: 1.0,
                 minor: 0.4,
             },
+            cube(),
         ] {
             let mut m = Material::default();
             m.heights.sigma_h = 0.0;
             let flat = DisplacedObject::new(&m, shape.clone()).unwrap();
-            let s = flat.surface_samples(120, 1);
+            let s = flat.surface_samples(0.02, 1);
             let total: f64 = s.iter().map(|q| q.area).sum();
             assert!(
                 (total / shape.area() - 1.0).abs() < 2e-3,
-                "{shape:?}: {total}"
+                "{shape:?}: {total} against {}",
+                shape.area()
             );
 
-            m.heights.sigma_h = 0.02;
-            m.slopes.sigma_nx = 0.25;
-            m.slopes.sigma_ny = 0.25;
-            let bumpy = DisplacedObject::new(&m, shape.clone()).unwrap();
-            let s = bumpy.surface_samples(200, 2);
-            assert!(s.len() == 200 * 200, "{}", s.len());
+            let bumpy = bumpy(shape.clone());
+            let s = bumpy.surface_samples(0.02, 2);
             for q in &s {
                 assert!(bumpy.gap(q.p).abs() < 1e-6);
                 assert!((q.n - bumpy.normal(q.p)).length() < 1e-9);
@@ -96,6 +158,45 @@ mod tests {
             // Mean √(1 + |∇h|²) for slopes of variance 2·0.25²: about 1 + 0.25² = 1.0625.
             let ratio = total / shape.area();
             assert!(ratio > 1.03 && ratio < 1.10, "{shape:?}: {ratio}");
+        }
+    }
+
+    /// The samples close the surface, sharp edges included: by the divergence theorem a closed
+    /// surface has `∮ n dA = 0` and `⅓∮ p·n dA` = the volume it holds, here counted independently
+    /// on a jittered grid of points with F < 0. A displaced cube's relief raises rounded wedges
+    /// over its edges and folds where two faces' reliefs meet; the first version's samples (base
+    /// points traced back along the base normal) missed the one and doubled the other: the cube's
+    /// volume read 5.2% large and its `|∮n dA|` 0.86% of its area (the sphere's 0.26%: the base's
+    /// curvature factor was left out of the areas); these samples close both to within 0.07%.
+    #[test]
+    fn the_samples_close_the_surface() {
+        use crate::math::random::splitmix;
+        for shape in [BaseShape::Sphere { radius: 1.0 }, cube()] {
+            let obj = bumpy(shape.clone());
+            let s = obj.surface_samples(0.02, 3);
+            let area: f64 = s.iter().map(|q| q.area).sum();
+            let flux: DVec3 = s.iter().map(|q| q.n * q.area).sum();
+            let volume: f64 = s.iter().map(|q| q.p.dot(q.n) * q.area).sum::<f64>() / 3.0;
+            assert!(flux.length() < 1e-3 * area, "{shape:?}: ∮n dA = {flux}");
+            // Brute force: the share of a jittered 56³ grid over the bounding cube inside.
+            let (r, cells) = (obj.bounding_radius(), 56);
+            let cell = 2.0 * r / cells as f64;
+            let mut rng = 5u64;
+            let mut inside = 0usize;
+            for k in 0..cells * cells * cells {
+                let (i, j, l) = (k % cells, k / cells % cells, k / (cells * cells));
+                let p = DVec3::new(
+                    -r + (i as f64 + splitmix(&mut rng)) * cell,
+                    -r + (j as f64 + splitmix(&mut rng)) * cell,
+                    -r + (l as f64 + splitmix(&mut rng)) * cell,
+                );
+                inside += usize::from(obj.gap(p) < 0.0);
+            }
+            let counted = inside as f64 * cell.powi(3);
+            assert!(
+                (volume / counted - 1.0).abs() < 2e-3,
+                "{shape:?}: ⅓∮p·n dA = {volume}, counted {counted}"
+            );
         }
     }
 }
