@@ -154,14 +154,44 @@ fn set(shared: &Mutex<Shared>, f: impl FnOnce(&mut Shared)) {
     }
 }
 
+/// A voxel frame slower than this is preceded by a smaller preview (progressive refinement).
+const PREVIEW_ABOVE_S: f64 = 0.2;
+
+/// The time a preview aims at.
+const PREVIEW_TARGET_S: f64 = 0.08;
+
+/// The factor a preview's sides are divided by, from the seconds the last full frame took: 1 (no
+/// preview) up to [`PREVIEW_ABOVE_S`], then the smallest factor k ≥ 2 whose k² fewer cones take
+/// about [`PREVIEW_TARGET_S`], at most 8. A frame's cost is its cone count times a cost per cone
+/// that changes slowly with the view (the object's distance), so the last frame predicts the next.
+fn preview_divisor(last_full_s: f64) -> u32 {
+    if !(last_full_s > PREVIEW_ABOVE_S) {
+        return 1;
+    }
+    ((last_full_s / PREVIEW_TARGET_S).sqrt().ceil() as u32).clamp(2, 8)
+}
+
 /// The background thread: builds, renders, compares; later jobs of a kind replace earlier ones.
+/// A voxel frame that would be slow is drawn first at a fraction of the size, and the full frame
+/// only when no newer camera or build is waiting by then: while the camera moves the view keeps
+/// up at preview size and sharpens when it rests.
 fn run(jobs: Receiver<Job>, shared: Arc<Mutex<Shared>>, device: DeviceSource, repaint: impl Fn()) {
     super::priority::lower_current_thread();
     let mut scene: Option<(ObjectScene, Material, Option<GpuObject>)> = None;
     let table = MaskTable::new();
-    while let Ok(first) = jobs.recv() {
+    let mut backlog: Vec<Job> = Vec::new();
+    let mut last_full_s = 0.0;
+    loop {
+        let mut batch = std::mem::take(&mut backlog);
+        if batch.is_empty() {
+            match jobs.recv() {
+                Ok(j) => batch.push(j),
+                Err(_) => break,
+            }
+        }
+        batch.extend(jobs.try_iter());
         let (mut build, mut render, mut compare) = (None, None, None);
-        for job in std::iter::once(first).chain(jobs.try_iter()) {
+        for job in batch {
             match job {
                 Job::Build(b) => build = Some(b),
                 Job::Render(s) => render = Some(s),
@@ -176,6 +206,7 @@ fn run(jobs: Receiver<Job>, shared: Arc<Mutex<Shared>>, device: DeviceSource, re
             });
             repaint();
             scene = None;
+            last_full_s = 0.0;
             match ObjectScene::build(&material, shape, depth) {
                 Ok(sc) => {
                     let gpu = (device == DeviceSource::Headless)
@@ -210,23 +241,46 @@ fn run(jobs: Receiver<Job>, shared: Arc<Mutex<Shared>>, device: DeviceSource, re
         };
         if let Some(shot) = render {
             let light = ObjectLighting::of_material(material, shot.light);
-            let started = std::time::Instant::now();
-            let px = match gpu {
-                Some(g) => g
-                    .render(
-                        &masks_shot(&shot.camera, &light, shot.shadows, shot.size, shot.lens),
-                        false,
-                    )
-                    .map(|(p, _)| p)
-                    .map_err(|e| format!("{e:#}")),
-                None => Ok(cpu_masks(sc, &table, &light, &shot)),
+            let draw = |shot: &Shot| {
+                let started = std::time::Instant::now();
+                let px = match gpu {
+                    Some(g) => g
+                        .render(
+                            &masks_shot(&shot.camera, &light, shot.shadows, shot.size, shot.lens),
+                            false,
+                        )
+                        .map(|(p, _)| p)
+                        .map_err(|e| format!("{e:#}")),
+                    None => Ok(cpu_masks(sc, &table, &light, shot)),
+                };
+                let secs = started.elapsed().as_secs_f64();
+                set(&shared, |s| match px {
+                    Ok(p) => s.voxel = Some((shot.size.0, shot.size.1, p, secs)),
+                    Err(e) => s.status = e,
+                });
+                repaint();
+                secs
             };
-            let secs = started.elapsed().as_secs_f64();
-            set(&shared, |s| match px {
-                Ok(p) => s.voxel = Some((shot.size.0, shot.size.1, p, secs)),
-                Err(e) => s.status = e,
-            });
-            repaint();
+            let k = preview_divisor(last_full_s);
+            if k > 1 {
+                let (w, h) = shot.size;
+                draw(&Shot {
+                    size: ((w / k).max(1), (h / k).max(1)),
+                    ..shot
+                });
+                backlog.extend(jobs.try_iter());
+                if backlog
+                    .iter()
+                    .any(|j| matches!(j, Job::Render(_) | Job::Build(_)))
+                {
+                    // A newer camera or object: its frame replaces this one's full size.
+                    if let Some((s, r)) = compare {
+                        backlog.push(Job::Compare(s, r));
+                    }
+                    continue;
+                }
+            }
+            last_full_s = draw(&shot);
         }
         if let Some((shot, rays)) = compare {
             set(&shared, |s| {
@@ -573,10 +627,12 @@ impl ObjectPanel {
         };
         let mut images = vec![];
         if let Some((w, h, px, secs)) = &s.voxel {
-            images.push((
-                format!("voxels, ours (live, {:.0} ms)", 1e3 * secs),
-                color_image(*w, *h, px),
-            ));
+            let label = if *w < SIZE.0 {
+                format!("voxels, ours (preview {w} × {h}, {:.0} ms)", 1e3 * secs)
+            } else {
+                format!("voxels, ours (live, {:.0} ms)", 1e3 * secs)
+            };
+            images.push((label, color_image(*w, *h, px)));
         }
         if let Some((w, h, panels, _)) = &s.compare {
             for (name, px) in panels {
@@ -593,5 +649,29 @@ impl ObjectPanel {
                 (name, tex)
             })
             .collect();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Quick frames get no preview; slower ones one whose k² fewer cones take at most the target
+    /// (while k is below its cap), never a factor below 2 or above 8, and never from a NaN.
+    #[test]
+    fn previews_shrink_with_the_last_frames_cost() {
+        assert_eq!(preview_divisor(0.0), 1);
+        assert_eq!(preview_divisor(PREVIEW_ABOVE_S), 1);
+        assert_eq!(preview_divisor(f64::NAN), 1);
+        for secs in [0.21, 0.5, 1.0, 2.1, 4.0] {
+            let k = preview_divisor(secs);
+            assert!((2..=8).contains(&k), "{secs}: {k}");
+            assert!(secs / f64::from(k * k) <= PREVIEW_TARGET_S, "{secs}: {k}");
+            assert!(
+                k == 2 || secs / f64::from((k - 1) * (k - 1)) > PREVIEW_TARGET_S,
+                "{secs}: {k} is not the smallest"
+            );
+        }
+        assert_eq!(preview_divisor(1e9), 8);
     }
 }
