@@ -231,24 +231,39 @@ fn a_stopped_renderer_is_restarted_and_the_views_come_back() {
     }
     h.state_mut().view.max_scale = 1.0 / 16.0;
     settle(&mut h, Duration::from_secs(240));
-    let (_, mut req) = h.state().last_request.clone().expect("a request");
-    req.generation = super::worker::PANIC_GENERATION;
-    h.state().worker.request(req);
-    let t0 = Instant::now();
-    while h.state().restarts == 0 {
-        assert!(t0.elapsed() < Duration::from_secs(60), "no restart");
-        h.step();
-        std::thread::sleep(Duration::from_millis(10));
+    // The driver's own lock timeout can stop the thread first on a loaded machine (seen in CI
+    // beside a heavy job): that restart is counted and the injection is tried again, at most
+    // three times; every stop must be followed by a restart.
+    let mut injected = false;
+    for attempt in 1..=3 {
+        let (_, mut req) = h.state().last_request.clone().expect("a request");
+        req.generation = super::worker::PANIC_GENERATION;
+        let before = h.state().restarts;
+        h.state().worker.request(req);
+        let t0 = Instant::now();
+        while h.state().restarts == before {
+            assert!(t0.elapsed() < Duration::from_secs(60), "no restart");
+            h.step();
+            std::thread::sleep(Duration::from_millis(10));
+        }
+        let notice = h.state().notice.clone().expect("a notice");
+        assert!(notice.error, "{}", notice.text);
+        settle(&mut h, Duration::from_secs(240));
+        assert!(matches!(h.state().device, DeviceStatus::Ready(_)));
+        assert!(h.state().restarts >= attempt);
+        if notice.text.contains("injected") {
+            injected = true;
+            break;
+        }
+        eprintln!(
+            "attempt {attempt}: the driver stopped first ({})",
+            notice.text
+        );
     }
-    let notice = h.state().notice.clone().expect("a notice");
     assert!(
-        notice.error && notice.text.contains("injected"),
-        "{}",
-        notice.text
+        injected,
+        "the injected panic never reached the render thread"
     );
-    settle(&mut h, Duration::from_secs(240));
-    assert!(matches!(h.state().device, DeviceStatus::Ready(_)));
-    assert_eq!(h.state().restarts, 1);
 }
 
 #[test]
