@@ -428,25 +428,8 @@ fn split(
 mod tests {
     use super::*;
     use crate::math::random::splitmix;
+    use crate::object::cube_obj;
     use crate::object::icosphere::icosphere_obj;
-
-    fn cube_obj() -> String {
-        let mut s = String::new();
-        for z in [-1.0, 1.0] {
-            for y in [-1.0, 1.0] {
-                for x in [-1.0, 1.0] {
-                    s += &format!("v {x} {y} {z}\n");
-                }
-            }
-        }
-        // Quads, outward (counter-clockwise seen from outside); tobj triangulates them.
-        for f in [
-            "1 3 4 2", "5 6 8 7", "1 2 6 5", "3 7 8 4", "1 5 7 3", "2 4 8 6",
-        ] {
-            s += &format!("f {f}\n");
-        }
-        s
-    }
 
     /// The cube's signed distance is the box's, exactly, inside and out, at edges and corners.
     #[test]

@@ -20,6 +20,26 @@ pub mod view_error;
 pub mod voxel_field;
 pub mod voxel_stats;
 
+/// A cube of side 2 centred on the origin as OBJ text (quads, counter-clockwise seen from
+/// outside; tobj triangulates them), for the module's tests.
+#[cfg(test)]
+pub(crate) fn cube_obj() -> String {
+    let mut s = String::new();
+    for z in [-1.0, 1.0] {
+        for y in [-1.0, 1.0] {
+            for x in [-1.0, 1.0] {
+                s += &format!("v {x} {y} {z}\n");
+            }
+        }
+    }
+    for f in [
+        "1 3 4 2", "5 6 8 7", "1 2 6 5", "3 7 8 4", "1 5 7 3", "2 4 8 6",
+    ] {
+        s += &format!("f {f}\n");
+    }
+    s
+}
+
 /// The camera of the module's tests: 60° from the pole, azimuth 30°, a 30° field of view, looking
 /// at the origin from `distance`.
 #[cfg(test)]

@@ -99,29 +99,9 @@ mod tests {
 
     /// A cube of side 2 as an OBJ mesh.
     fn cube() -> BaseShape {
-        let mut obj = String::new();
-        for z in [-1, 1] {
-            for y in [-1, 1] {
-                for x in [-1, 1] {
-                    obj += &format!("v {x} {y} {z}\n");
-                }
-            }
-        }
-        // Vertex k = 1 + x + 2y + 4z (bits); faces counter-clockwise from outside.
-        for f in [
-            [1, 3, 4, 2],
-            [5, 6, 8, 7],
-            [1, 2, 6, 5],
-            [3, 7, 8, 4],
-            [1, 5, 7, 3],
-            [2, 4, 8, 6],
-        ] {
-            obj += &format!(
-                "f {} {} {}\nf {} {} {}\n",
-                f[0], f[1], f[2], f[0], f[2], f[3]
-            );
-        }
-        BaseShape::Mesh(Arc::new(TriMesh::from_obj(&obj).unwrap()))
+        BaseShape::Mesh(Arc::new(
+            TriMesh::from_obj(&crate::object::cube_obj()).unwrap(),
+        ))
     }
 
     /// The samples lie on the surface, their normals are the surface's, and their areas add up to
