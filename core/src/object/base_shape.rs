@@ -145,34 +145,6 @@ impl BaseShape {
         }
     }
 
-    /// `n × n` points spread over the surface, each with the area it stands for (summing to the
-    /// surface's): an analytic shape's parameter cells ([`BaseShape::point_at`]), one jittered
-    /// point each; a mesh's triangles by area ([`TriMesh::surface_points`]).
-    pub fn surface_points(&self, n: usize, seed: u64) -> Vec<(DVec3, f64)> {
-        use crate::math::random::splitmix;
-        use std::f64::consts::TAU;
-        if let Self::Mesh(m) = self {
-            return m.surface_points(n * n, seed);
-        }
-        let mut rng = seed;
-        let cells = (n * n) as f64;
-        let mut out = Vec::with_capacity(n * n);
-        for j in 0..n {
-            for i in 0..n {
-                let u = (i as f64 + splitmix(&mut rng)) / n as f64;
-                let v = (j as f64 + splitmix(&mut rng)) / n as f64;
-                let area = match *self {
-                    Self::Torus { major, minor } => {
-                        TAU * TAU * minor * (major + minor * (TAU * v).cos()) / cells
-                    }
-                    _ => self.area() / cells,
-                };
-                out.push((self.point_at(u, v), area));
-            }
-        }
-        out
-    }
-
     /// The surface point at parameters (u, v) ∈ [0, 1)² (a sphere's longitude and the cosine of
     /// its colatitude, which is area-preserving; a torus's angles around the axis and around the
     /// tube): for sampling the surface in tests and statistics. Each call returns a point on the
