@@ -235,11 +235,7 @@ mod tests {
     use crate::math::random::splitmix;
 
     fn object(shape: BaseShape) -> DisplacedObject {
-        let mut m = Material::default();
-        m.heights.sigma_h = 0.02;
-        m.slopes.sigma_nx = 0.3;
-        m.slopes.sigma_ny = 0.3;
-        DisplacedObject::new(&m, shape).unwrap()
+        DisplacedObject::new(&crate::object::bumpy_material(0.3), shape).unwrap()
     }
 
     fn shapes() -> [BaseShape; 2] {

@@ -20,6 +20,17 @@ pub mod view_error;
 pub mod voxel_field;
 pub mod voxel_stats;
 
+/// The module tests' bumpy material: the default preset with σ_h = 0.02 and isotropic slope std
+/// `slope_std` (a relief well within a unit shape's quarter radius).
+#[cfg(test)]
+pub(crate) fn bumpy_material(slope_std: f64) -> crate::material::Material {
+    let mut m = crate::material::Material::default();
+    m.heights.sigma_h = 0.02;
+    m.slopes.sigma_nx = slope_std;
+    m.slopes.sigma_ny = slope_std;
+    m
+}
+
 /// A cube of side 2 centred on the origin as OBJ text (quads, counter-clockwise seen from
 /// outside; tobj triangulates them), for the module's tests.
 #[cfg(test)]

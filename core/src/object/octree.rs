@@ -152,10 +152,7 @@ mod tests {
     use crate::object::base_shape::BaseShape;
 
     fn object() -> (DisplacedObject, impl Fn(f64) -> [f64; 3]) {
-        let mut m = Material::default();
-        m.heights.sigma_h = 0.02;
-        m.slopes.sigma_nx = 0.25;
-        m.slopes.sigma_ny = 0.25;
+        let m = crate::object::bumpy_material(0.25);
         let obj = DisplacedObject::new(&m, BaseShape::Sphere { radius: 1.0 }).unwrap();
         (obj, |f: f64| [0.5 + 0.2 * f, 0.4, 0.3 - 0.1 * f])
     }

@@ -90,11 +90,7 @@ mod tests {
     use std::sync::Arc;
 
     fn bumpy(shape: BaseShape) -> DisplacedObject {
-        let mut m = Material::default();
-        m.heights.sigma_h = 0.02;
-        m.slopes.sigma_nx = 0.25;
-        m.slopes.sigma_ny = 0.25;
-        DisplacedObject::new(&m, shape).unwrap()
+        DisplacedObject::new(&crate::object::bumpy_material(0.25), shape).unwrap()
     }
 
     /// A cube of side 2 as an OBJ mesh.

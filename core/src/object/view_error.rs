@@ -302,7 +302,6 @@ pub fn view_errors(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::Material;
     use crate::microfacet::masking_shadowing::Correlation;
     use crate::object::base_shape::BaseShape;
     use crate::object::coverage_mask::MaskTable;
@@ -318,10 +317,7 @@ mod tests {
         depth: u32,
         body: impl FnOnce(&VoxelOctree, &ObjectTruth, &ConeTracer) -> R,
     ) -> R {
-        let mut m = Material::default();
-        m.heights.sigma_h = 0.02;
-        m.slopes.sigma_nx = 0.25;
-        m.slopes.sigma_ny = 0.25;
+        let m = crate::object::bumpy_material(0.25);
         let obj = DisplacedObject::new(&m, BaseShape::Sphere { radius: 1.0 }).unwrap();
         let ev = crate::eval::Evaluator::new(&m).unwrap();
         let color = |f: f64| ev.color_at(f);
