@@ -15,6 +15,14 @@
 //! thickens silhouettes. Nearest voxels ([`Compositing::Nearest`]) stop at the first finest-level
 //! voxel the surface crosses and shade it whole: what a blocky voxel renderer shows.
 //!
+//! Occupancy [our addition; HN12 have none]: a voxel whose surface covers a share α of its mean
+//! plane (the tips of peaks rising into it) shows that plane on α of the sub-rays
+//! ([`crate::object::coverage_mask::thinning_mask`], the same sub-rays for every element, so
+//! masks nest); the sub-rays it leaves open go on to the elements behind. An element more than its
+//! radius inside the blended surface is never thinned: the floor that stops open sub-rays leaking
+//! through the object (the field's α is below 1 on curved fine pieces too). Alpha blending takes
+//! the thinned mask's popcount as its opacity, so both baselines see the same occupancy.
+//!
 //! Shadows: from each element that contributes, a shadow cone of the element's radius toward the
 //! sun (a directional light keeps its width), starting one element length out, composited the
 //! same way; the sun's share is what it leaves uncovered.
@@ -155,7 +163,11 @@ impl Coverage {
 
 impl ConeTracer<'_> {
     /// The sub-rays an element of radius r covers, its sample's mean plane written in the cone's
-    /// frame (e₁, e₂ across it, d along it); all of them for nearest voxels.
+    /// frame (e₁, e₂ across it, d along it), thinned to the sample's occupancy (module docs); all
+    /// of them for nearest voxels. The floor: an element whose centre lies more than its radius
+    /// inside the blended surface is not thinned (it is wholly inside the object, whatever the
+    /// voxels' occupancies say), so sub-rays that thinner elements in front left open end on it
+    /// rather than leaking to the background.
     fn element_mask(
         &self,
         s: &VoxelSample,
@@ -168,7 +180,12 @@ impl ConeTracer<'_> {
         }
         let n = DVec3::new(s.normal.dot(e1), s.normal.dot(e2), s.normal.dot(d));
         let (theta, v) = element_mask_params(r, r, n, s.distance);
-        self.table.lookup(theta, v)
+        let mask = self.table.lookup(theta, v);
+        if s.distance < -r {
+            mask
+        } else {
+            mask & self.table.thinning(s.occupancy)
+        }
     }
 
     /// The pixel of `cone` (module docs).
@@ -263,6 +280,7 @@ impl ConeTracer<'_> {
                     color_mean: d.color_mean,
                     color_height: d.color_height,
                     support: 1.0,
+                    occupancy: 1.0,
                 }),
                 _ => f.sample(c, level),
             };
@@ -334,4 +352,115 @@ fn box_exit(o: DVec3, d: DVec3, lo: DVec3, hi: DVec3) -> f64 {
         }
     }
     t1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::microfacet::brdf::BaseBrdf;
+    use crate::object::coverage_mask::{MASK_BITS, MaskTable, thinning_count};
+    use crate::object::octree::VoxelOctree;
+    use crate::object::surface_samples::SurfaceSample;
+
+    /// A layer of tips over a plane, seen from above: a blue floor at the
+    /// centre of one voxel layer and red plates covering a quarter of the layer above (squares of
+    /// side 0.025 every 0.05), as the peaks' tips over a valley floor. The plates' voxels hold a
+    /// quarter of their mean plane (occupancy ¼ from the samples), so a cone straight down must see
+    /// red on a quarter of its sub-rays and the floor on the rest, whatever its position across the
+    /// voxels; without the occupancy (every α = 1) the plates' voxels covered the whole pixel red.
+    #[test]
+    fn a_layer_of_tips_shows_its_covered_share() {
+        let step = 0.005;
+        let cells = (2.0 / step) as usize;
+        let mut samples = vec![];
+        for i in 0..cells {
+            for j in 0..cells {
+                let (x, y) = (
+                    -1.0 + (i as f64 + 0.5) * step,
+                    -1.0 + (j as f64 + 0.5) * step,
+                );
+                let sample = |z: f64, f: f64| SurfaceSample {
+                    p: DVec3::new(x, y, z),
+                    n: DVec3::Z,
+                    m: DVec3::Z,
+                    area: step * step,
+                    f,
+                };
+                // Depth 3 over [−1, 1]³: voxels 0.25 wide, layer 3 centred at −0.125, layer 4 at
+                // 0.125.
+                samples.push(sample(-0.125, 0.0));
+                if (x + 1.0).rem_euclid(0.05) < 0.025 && (y + 1.0).rem_euclid(0.05) < 0.025 {
+                    samples.push(sample(0.125, 1.0));
+                }
+            }
+        }
+        let color = |f: f64| {
+            if f > 0.5 {
+                [1.0, 0.0, 0.0]
+            } else {
+                [0.0, 0.0, 1.0]
+            }
+        };
+        let tree = VoxelOctree::from_samples(&samples, color, 1.0, 3);
+        let plates = tree.descriptor(3, [4, 4, 4]).unwrap();
+        assert!(
+            (plates.occupancy - 0.25).abs() < 1e-9,
+            "{}",
+            plates.occupancy
+        );
+        assert!((tree.descriptor(3, [4, 4, 3]).unwrap().occupancy - 1.0).abs() < 1e-9);
+        let lighting = ObjectLighting {
+            light: DVec3::Z,
+            sun: 1.0,
+            brdf: BaseBrdf {
+                specular: 0.0,
+                ..BaseBrdf::default()
+            },
+            correlation: Default::default(),
+        };
+        let table = MaskTable::new();
+        let red_share = |field: &VoxelField| {
+            let tracer = ConeTracer {
+                field,
+                table: &table,
+                lighting: &lighting,
+                shadows: false,
+            };
+            let mut rng = 4u64;
+            let mut shares = vec![];
+            for _ in 0..20 {
+                // From the top of the plates' layer, elements as wide as a voxel: their centres
+                // fall on the layers' centres (level 3 exactly), anywhere across.
+                let (x, y) = (
+                    crate::math::random::splitmix(&mut rng) - 0.5,
+                    crate::math::random::splitmix(&mut rng) - 0.5,
+                );
+                let cone = Cone {
+                    origin: DVec3::new(x, y, 0.25),
+                    dir: -DVec3::Z,
+                    radius0: 0.125,
+                    spread: 0.0,
+                    lens: 0.0,
+                    focus: 1.0,
+                };
+                let p = tracer.trace(&cone, Compositing::Masks);
+                assert_eq!(p.coverage, 1.0);
+                shares.push(p.color[0] / (p.color[0] + p.color[2]));
+            }
+            shares
+        };
+        let expect = thinning_count(0.25) as f64 / MASK_BITS as f64;
+        for s in red_share(&VoxelField::new(&tree)) {
+            assert!((s - expect).abs() < 1e-9, "{s} vs {expect}");
+        }
+        let mut solid = VoxelField::new(&tree);
+        for level in &mut solid.levels {
+            for d in level.values_mut() {
+                d.occupancy = 1.0;
+            }
+        }
+        for s in red_share(&solid) {
+            assert!(s > 0.999, "{s}");
+        }
+    }
 }

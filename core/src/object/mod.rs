@@ -6,6 +6,7 @@
 pub mod base_shape;
 pub mod cone_trace;
 pub mod coverage_mask;
+pub mod cube_section;
 pub mod displaced;
 pub mod dolly;
 pub mod icosphere;

@@ -18,7 +18,8 @@ use glam::DVec3;
 use std::collections::HashMap;
 
 /// Bytes of one voxel's descriptor on the GPU: h̄ as f32, and as f16 σ_h², n̄ (3), the slope
-/// covariance (3), ā (3) and a_s (3), padded to 32 (HN12 Sec. 5.2: 15–20 with 8-bit colours).
+/// covariance (3), ā (3), a_s (3) and the occupancy α (HN12 Sec. 5.2: 15–20 with 8-bit colours
+/// and no occupancy).
 pub const GPU_BYTES_PER_VOXEL: usize = 32;
 
 /// Deepest level accepted (2^12 = 4096 voxels per axis).
@@ -125,9 +126,15 @@ impl VoxelOctree {
         self.levels.get(level as usize)?.get(&key)
     }
 
-    /// A voxel's descriptors.
+    /// A voxel's descriptors, its occupancy in the voxel included.
     pub fn descriptor(&self, level: u32, key: [u32; 3]) -> Option<VoxelDescriptor> {
-        self.moments(level, key)?.descriptor()
+        let size = self.voxel_size(level);
+        let lo = self.center(level, key) - DVec3::splat(0.5 * size);
+        Some(
+            self.moments(level, key)?
+                .descriptor()?
+                .with_occupancy_in(lo, size),
+        )
     }
 
     /// Occupied voxels and GPU bytes per level.
@@ -185,16 +192,24 @@ mod tests {
                         ));
                     }
                 }
+                let size = tree.voxel_size(level);
+                let lo = tree.center(level, *key) - DVec3::splat(0.5 * size);
                 let (Some(a), Some(b)) = (tree.descriptor(level, *key), m.descriptor()) else {
                     continue;
                 };
+                let b = b.with_occupancy_in(lo, size);
                 let count = a.area / sample_area;
                 if count < 30.0 {
                     continue; // a corner clipped by the surface: too few samples to compare
                 }
                 checked += 1;
                 let se = 4.0 / count.sqrt();
-                let size = tree.voxel_size(level);
+                assert!(
+                    (a.occupancy - b.occupancy).abs() < se,
+                    "l{level} occupancy {} {}",
+                    a.occupancy,
+                    b.occupancy
+                );
                 assert!(
                     (a.area / b.area - 1.0).abs() < se,
                     "l{level} area {} {}",

@@ -36,6 +36,9 @@ pub struct VoxelSample {
     pub color_height: [f64; 3],
     /// The occupied voxels' share of the trilinear weight, in (0, 1].
     pub support: f64,
+    /// α ∈ [0, 1]: the share of the blended mean plane the surface covers
+    /// ([`VoxelDescriptor::occupancy`], blended like σ_h²).
+    pub occupancy: f64,
 }
 
 /// The descriptors of every occupied voxel, per level (built once from a [`VoxelOctree`]).
@@ -70,9 +73,10 @@ impl VoxelField {
             levels: tree
                 .levels
                 .iter()
-                .map(|l| {
-                    l.iter()
-                        .filter_map(|(k, m)| Some((*k, m.descriptor()?)))
+                .enumerate()
+                .map(|(level, l)| {
+                    l.keys()
+                        .filter_map(|k| Some((*k, tree.descriptor(level as u32, *k)?)))
                         .collect()
                 })
                 .collect(),
@@ -112,7 +116,7 @@ impl VoxelField {
         let map = &self.levels[level as usize];
         let (mut w_sum, mut dist, mut normal, mut hv, mut slopes) =
             (0.0, 0.0, DVec3::ZERO, 0.0, DMat3::ZERO);
-        let (mut am, mut ah) = ([0.0; 3], [0.0; 3]);
+        let (mut am, mut ah, mut occupancy) = ([0.0; 3], [0.0; 3], 0.0);
         for corner in 0..8 {
             let off = [corner & 1, (corner >> 1) & 1, (corner >> 2) & 1];
             let idx = [0, 1, 2].map(|a| base[a] as i64 + off[a] as i64);
@@ -132,6 +136,7 @@ impl VoxelField {
             dist += w * d.plane_distance(x);
             normal += w * d.normal;
             hv += w * d.height_var;
+            occupancy += w * d.occupancy;
             slopes += tensor(d.tangents, &d.slope_cov) * w;
             for k in 0..3 {
                 am[k] += w * d.color_mean[k];
@@ -153,6 +158,7 @@ impl VoxelField {
             color_mean: am.map(|a| a * inv),
             color_height: ah.map(|a| a * inv),
             support: w_sum,
+            occupancy: occupancy * inv,
         })
     }
 
@@ -191,6 +197,7 @@ fn mix(a: &VoxelSample, b: &VoxelSample, f: f64) -> VoxelSample {
         color_mean: [0, 1, 2].map(|k| lerp(a.color_mean[k], b.color_mean[k])),
         color_height: [0, 1, 2].map(|k| lerp(a.color_height[k], b.color_height[k])),
         support: lerp(a.support, b.support),
+        occupancy: lerp(a.occupancy, b.occupancy),
     }
 }
 

@@ -16,10 +16,23 @@
 //!   in h over Gaussian heights: `Cov(h, s) = σ_h/√π`, `Var(s) = ⅓`, so `a_s = 3 Cov(a, h)/(√π σ_h)`
 //!   (0 when σ_h = 0).
 //!
+//! - the occupancy `α = min(1, |Σ A n| / A_section)`, where `A_section` is the area of the mean
+//!   plane's section of the voxel ([`plane_section_area`]): the share of the voxel's mean plane the
+//!   surface covers, seen along n̄ (`|Σ A n|` is the surface's area projected on that plane, folds
+//!   counted once). A flat piece has α = 1 however it clips the voxel; a voxel that holds only the
+//!   tips of peaks rising into it has α well below 1, and the cone tracer shows its mean plane on
+//!   that share of a pixel's sub-rays only (`cone_trace.rs`). Without it such a voxel presents its
+//!   whole half-space and the tips, whose colour goes with height, get 1.3–2× their visible area
+//!   (docs/design.md, "Attributed per voxel"). This is our addition: HN12 store no occupancy beyond
+//!   the distance field.
+//!
 //! Edge cases: an empty voxel (no area) has no descriptor; normals that cancel (`|E[n]| < 1e-9`, a
-//! thin double-sided sliver) fall back to the principal axis of least position spread.
+//! thin double-sided sliver) fall back to the principal axis of least position spread; a
+//! descriptor made without its voxel ([`SurfaceMoments::descriptor`]) has occupancy 1 until
+//! [`VoxelDescriptor::with_occupancy_in`] gives it the voxel.
 
 use crate::microfacet::slopes::SlopeCov;
+use crate::object::cube_section::plane_section_area;
 use glam::{DMat3, DVec3};
 
 /// Additive sums of a piece of surface (module docs). `Default` is the empty piece (all sums 0;
@@ -110,7 +123,8 @@ impl SurfaceMoments {
         }
     }
 
-    /// The descriptors (module docs); `None` for an empty piece.
+    /// The descriptors (module docs), occupancy 1 (the voxel is not known here:
+    /// [`VoxelDescriptor::with_occupancy_in`]); `None` for an empty piece.
     pub fn descriptor(&self) -> Option<VoxelDescriptor> {
         if !(self.area > 0.0) {
             return None;
@@ -159,6 +173,7 @@ impl SurfaceMoments {
             slope_cov,
             color_mean,
             color_height,
+            occupancy: 1.0,
         })
     }
 }
@@ -227,9 +242,28 @@ pub struct VoxelDescriptor {
     pub color_mean: [f64; 3],
     /// a_s per channel, the colour's correlation with height [HN12 Eq. 17].
     pub color_height: [f64; 3],
+    /// α ∈ [0, 1], the share of the mean plane's section of the voxel the surface covers (module
+    /// docs); 1 for a flat piece.
+    pub occupancy: f64,
 }
 
 impl VoxelDescriptor {
+    /// The descriptor with its occupancy in the voxel `[lo, lo + size]³` (module docs): 1 where the
+    /// section has no area (the mean plane only touches the voxel) or the quotient is not finite.
+    #[must_use]
+    pub fn with_occupancy_in(self, lo: DVec3, size: f64) -> Self {
+        let section = plane_section_area(self.centroid, self.normal, lo, size);
+        let alpha = self.agreement * self.area / section;
+        Self {
+            occupancy: if section > 0.0 && alpha.is_finite() {
+                alpha.clamp(0.0, 1.0)
+            } else {
+                1.0
+            },
+            ..self
+        }
+    }
+
     /// The signed distance from x to the mean plane (HN12's macroscopic distance field h̄).
     pub fn plane_distance(&self, x: DVec3) -> f64 {
         (x - self.centroid).dot(self.normal)
@@ -299,6 +333,7 @@ mod tests {
             },
             color_mean: am,
             color_height: asl,
+            occupancy: 1.0,
         }
     }
 

@@ -6,7 +6,7 @@
 //!
 //! A voxel's words (`shaders/object/voxel_field.wgsl` `voxel_at` unpacks them):
 //! the mean plane's offset from the voxel's centre along its normal as f32, then as f16 pairs
-//! (n̄x, n̄y), (n̄z, σ_h²), (σxx, σyy), (σxy, ā_r), (ā_g, ā_b), (a_s r, a_s g), (a_s b, 0), the slope
+//! (n̄x, n̄y), (n̄z, σ_h²), (σxx, σyy), (σxy, ā_r), (ā_g, ā_b), (a_s r, a_s g), (a_s b, α), the slope
 //! covariance written in the frame `any_orthonormal_pair` of the stored normal (the GPU rebuilds
 //! it). [`GpuVoxels::decode`] turns the words back into a [`VoxelField`]: the field the GPU sees,
 //! so core's cone tracer over it is the reference the WGSL must reproduce to f32 precision, and the
@@ -154,7 +154,7 @@ impl GpuVoxels {
             pack(s.xy, a[0]),
             pack(a[1], a[2]),
             pack(h[0], h[1]),
-            pack(h[2], 0.0),
+            pack(h[2], d.occupancy),
         ]
     }
 
@@ -171,7 +171,7 @@ impl GpuVoxels {
             let (xy, r) = unpack(w[4]);
             let (g, b) = unpack(w[5]);
             let (hr, hg) = unpack(w[6]);
-            let (hb, _) = unpack(w[7]);
+            let (hb, occupancy) = unpack(w[7]);
             let (t1, t2) = normal.any_orthonormal_pair();
             let d = VoxelDescriptor {
                 area: 1.0,
@@ -183,6 +183,7 @@ impl GpuVoxels {
                 slope_cov: SlopeCov { xx, yy, xy },
                 color_mean: [r, g, b],
                 color_height: [hr, hg, hb],
+                occupancy,
             };
             levels[level as usize].insert(c, d);
         }

@@ -68,15 +68,20 @@ fn coverage_full(c: Coverage, mode: u32) -> bool {
     return c.covered.x == 0xffffffffu && c.covered.y == 0xffffffffu;
 }
 
-// ConeTracer::element_mask: the element's mask in the cone's frame (e1, e2, d); nearest voxels are
-// opaque.
+// ConeTracer::element_mask: the element's mask in the cone's frame (e1, e2, d), thinned to the
+// sample's occupancy unless the element lies more than its radius inside (the floor); nearest
+// voxels are opaque.
 fn element_mask(s: VoxelSample, e1: vec3<f32>, e2: vec3<f32>, d: vec3<f32>, r: f32, mode: u32) -> vec2<u32> {
     if (mode == MODE_NEAREST) {
         return vec2<u32>(0xffffffffu, 0xffffffffu);
     }
     let n = vec3<f32>(dot(s.normal, e1), dot(s.normal, e2), dot(s.normal, d));
     let p = element_mask_params(r, r, n, s.distance);
-    return mask_lookup(p.x, p.y);
+    let mask = mask_lookup(p.x, p.y);
+    if (s.distance < -r) {
+        return mask;
+    }
+    return mask & thinning(s.occupancy);
 }
 
 // GPU only: the slab of one axis, (entry, exit) of the ray between lo and hi along it; the whole
@@ -213,6 +218,7 @@ fn march_step(cone: Cone, mode: u32, st: ptr<function, MarchState>) -> Step {
             s.color_mean = d.color_mean;
             s.color_height = d.color_height;
             s.support = 1.0;
+            s.occupancy = 1.0;
         }
     } else {
         s = voxel_sample(c, level);

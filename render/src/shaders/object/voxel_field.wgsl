@@ -16,6 +16,7 @@ struct VoxelSample {
     color_mean: vec3<f32>,
     color_height: vec3<f32>,
     support: f32,
+    occupancy: f32,
     found: bool,
 }
 
@@ -28,6 +29,7 @@ struct Voxel {
     slope_cov: vec3<f32>,
     color_mean: vec3<f32>,
     color_height: vec3<f32>,
+    occupancy: f32,
 }
 
 // An orthonormal tangent pair of the unit vector n.
@@ -57,14 +59,15 @@ fn voxel_at(i: u32) -> Voxel {
     let sxy_r = unpack2x16float(b.x);
     let gb = unpack2x16float(b.y);
     let hr_hg = unpack2x16float(b.z);
-    let hb = unpack2x16float(b.w);
+    let hb_occ = unpack2x16float(b.w);
     return Voxel(
         bitcast<f32>(a.x),
         normalize(vec3<f32>(nxy, nz_hv.x)),
         nz_hv.y,
         vec3<f32>(sxx_syy, sxy_r.x),
         vec3<f32>(sxy_r.y, gb),
-        vec3<f32>(hr_hg, hb.x),
+        vec3<f32>(hr_hg, hb_occ.x),
+        hb_occ.y,
     );
 }
 
@@ -169,6 +172,7 @@ struct FieldSum {
     slopes: mat3x3<f32>,
     am: vec3<f32>,
     ah: vec3<f32>,
+    occ: f32,
 }
 
 // GPU only: one corner `off` of sample_level (its loop body, written out eight times).
@@ -196,6 +200,7 @@ fn voxel_corner(acc: ptr<function, FieldSum>, x: vec3<f32>, level: u32, base: ve
     (*acc).slopes += tensor(f.t1, f.t2, d.slope_cov) * w;
     (*acc).am += w * d.color_mean;
     (*acc).ah += w * d.color_height;
+    (*acc).occ += w * d.occupancy;
 }
 
 // VoxelField::sample_level: the trilinear blend of the occupied voxels around x at one level.
@@ -207,7 +212,7 @@ fn sample_level(x: vec3<f32>, level_in: u32) -> VoxelSample {
     let q = (x + vec3<f32>(object.half)) / (2.0 * object.half) * cells - vec3<f32>(0.5);
     let base = floor(q);
     let frac = q - base;
-    var acc = FieldSum(0.0, 0.0, vec3<f32>(0.0), 0.0, mat3x3<f32>(), vec3<f32>(0.0), vec3<f32>(0.0));
+    var acc = FieldSum(0.0, 0.0, vec3<f32>(0.0), 0.0, mat3x3<f32>(), vec3<f32>(0.0), vec3<f32>(0.0), 0.0);
     voxel_corner(&acc, x, level, base, frac, vec3<u32>(0u, 0u, 0u));
     voxel_corner(&acc, x, level, base, frac, vec3<u32>(1u, 0u, 0u));
     voxel_corner(&acc, x, level, base, frac, vec3<u32>(0u, 1u, 0u));
@@ -235,6 +240,7 @@ fn sample_level(x: vec3<f32>, level_in: u32) -> VoxelSample {
     out.color_mean = acc.am * inv;
     out.color_height = acc.ah * inv;
     out.support = acc.w;
+    out.occupancy = acc.occ * inv;
     out.found = true;
     return out;
 }
@@ -275,6 +281,7 @@ fn mix_samples(a: VoxelSample, b: VoxelSample, f: f32) -> VoxelSample {
     out.color_mean = mix(a.color_mean, b.color_mean, vec3<f32>(f));
     out.color_height = mix(a.color_height, b.color_height, vec3<f32>(f));
     out.support = mix(a.support, b.support, f);
+    out.occupancy = mix(a.occupancy, b.occupancy, f);
     out.found = true;
     return out;
 }
