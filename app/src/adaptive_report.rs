@@ -204,6 +204,59 @@ pub struct PredictionCheck {
     pub log_correlation: f64,
     /// Median of predicted over measured (1: unbiased in scale).
     pub median_ratio: f64,
+    /// The most any per-pixel ray counts can buy ([`allocation_gains`]): uniform rays over the
+    /// best allocation's at equal error, from the reference's measured deviations.
+    pub best_allocation_gain: f64,
+    /// What the model's counts buy on the same measure ([`allocation_gains`]).
+    pub predicted_allocation_gain: f64,
+}
+
+/// Uniform rays over adaptive rays at equal error for per-pixel ray counts, if each pixel's error
+/// were its Monte Carlo variance: with `s_p²` the variance of one ray at pixel p (summed over RGB,
+/// as the report's RMSE sums them) and `n_p` its rays, the error is `Σ s_p²/n_p`, so at equal total
+/// rays the gain of counts `n_p ∝ w_p` over uniform ones is `P · Σ s_p² / (Σ w_p · Σ s_p²/w_p)`.
+/// Returns `(best, predicted)`: the best is Neyman's `w_p = s_p` (BSSBH13 Sec. 2.4 with the true
+/// deviations), `P Σ s² / (Σ s)²`, which no per-pixel allocation exceeds on this measure; the
+/// predicted is the model's first-round weights, `ŝ_p + DEFENSIVE·mean ŝ` (as
+/// [`lodestone_render::adaptive_truth::progressive_counts`] starts). It reads the noise as
+/// independent rays: the truth's stratified rays converge faster than `1/n` on smooth pixels, and a
+/// pixel that glints converges slower, so it bounds what counts buy where the error is noise, not
+/// what a reconstruction across pixels buys. Pixels the reference gave fewer than two rays are left
+/// out; `None` without any variance or with sizes that do not match.
+pub fn allocation_gains(predicted: &[f64], reference: &TruthEstimate) -> Option<(f64, f64)> {
+    use lodestone_render::adaptive_truth::DEFENSIVE;
+    let img = reference.image();
+    let w = img.width;
+    if predicted.len() != img.pixels.len() {
+        return None;
+    }
+    let clean = |x: f64| if x.is_finite() && x > 0.0 { x } else { 0.0 };
+    let mean_pred =
+        predicted.iter().map(|x| clean(*x)).sum::<f64>() / predicted.len().max(1) as f64;
+    let (mut pixels, mut s2, mut s1) = (0.0, 0.0, 0.0);
+    let (mut w_sum, mut s2_over_w) = (0.0, 0.0);
+    for (i, (sd, px)) in predicted.iter().zip(&img.pixels).enumerate() {
+        let n = f64::from(px[3]);
+        if n < 2.0 {
+            continue;
+        }
+        let e = reference.pixel(i as u32 % w, i as u32 / w);
+        let var: f64 = e.var_mean.iter().map(|v| clean(*v) * n).sum();
+        let weight = if mean_pred > 0.0 {
+            clean(*sd) + DEFENSIVE * mean_pred
+        } else {
+            1.0
+        };
+        pixels += 1.0;
+        s2 += var;
+        s1 += var.sqrt();
+        w_sum += weight;
+        s2_over_w += var / weight;
+    }
+    if !(s2 > 0.0 && s2_over_w > 0.0) {
+        return None;
+    }
+    Some((pixels * s2 / (s1 * s1), pixels * s2 / (w_sum * s2_over_w)))
 }
 
 /// [`PredictionCheck`] of `predicted` (per pixel, row-major) against the reference's per-pixel
@@ -230,11 +283,14 @@ pub fn prediction_check(predicted: &[f64], reference: &TruthEstimate) -> Option<
     let mut ratios: Vec<f64> = a.iter().zip(&b).map(|(p, m)| p / m).collect();
     ratios.sort_by(f64::total_cmp);
     let log = |v: &[f64]| v.iter().map(|x| x.ln()).collect::<Vec<_>>();
+    let (best, model) = allocation_gains(predicted, reference).unwrap_or((f64::NAN, f64::NAN));
     Some(PredictionCheck {
         pixels: a.len(),
         rank_correlation: spearman(&a, &b),
         log_correlation: pearson(&log(&a), &log(&b)),
         median_ratio: ratios[ratios.len() / 2],
+        best_allocation_gain: best,
+        predicted_allocation_gain: model,
     })
 }
 
@@ -460,5 +516,59 @@ mod tests {
         let c = prediction_check(&reversed, &est).unwrap();
         assert!((c.rank_correlation + 1.0).abs() < 1e-12, "{c:?}");
         assert!(prediction_check(&predicted[..3], &est).is_none());
+    }
+
+    /// The allocation gains on pixels of known per-ray variances: equal deviations gain nothing;
+    /// deviations 0.1–0.4 (one pixel of one ray left out) give Neyman's `P Σ s²/(Σ s)²` exactly,
+    /// here ×3 for the three channels in both sums: 4·0.3/1 = 1.2; and a perfect prediction
+    /// gains less than the best by its defensive share, a flat one nothing.
+    #[test]
+    fn allocation_gains_follow_neyman() {
+        use lodestone_render::truth_noise::SampleMoments;
+        let build = |sds: &[f64]| {
+            let mut pixels: Vec<[f32; 4]> = vec![[2.0, 2.0, 2.0, 4.0]; sds.len()];
+            let mut sum_sq: Vec<[f32; 4]> = sds
+                .iter()
+                .map(|s| [(3.0 * s * s + 1.0) as f32; 4])
+                .collect();
+            pixels.push([0.5, 0.5, 0.5, 1.0]);
+            sum_sq.push([0.25; 4]);
+            let img = LinearImage {
+                width: sds.len() as u32 + 1,
+                height: 1,
+                pixels,
+            };
+            let moments = SampleMoments {
+                width: sds.len() as u32 + 1,
+                height: 1,
+                sum_sq,
+            };
+            (img, moments)
+        };
+        let (img, moments) = build(&[0.2; 4]);
+        let flat = TruthEstimate::new(&img, &moments).unwrap();
+        let (best, model) = allocation_gains(&[0.2, 0.2, 0.2, 0.2, 0.0], &flat).unwrap();
+        assert!(
+            (best - 1.0).abs() < 1e-4 && (model - 1.0).abs() < 1e-4,
+            "{best} {model}"
+        );
+        let (img, moments) = build(&[0.1, 0.2, 0.3, 0.4]);
+        let est = TruthEstimate::new(&img, &moments).unwrap();
+        let (best, model) = allocation_gains(&[0.1, 0.2, 0.3, 0.4, 0.0], &est).unwrap();
+        assert!((best - 1.2).abs() < 1e-3, "{best}");
+        assert!(model > 1.0 && model < best, "{model}");
+        // The model's weights s + ½·mean(s), the fifth pixel's 0 in the mean:
+        let mean = 1.0 / 5.0;
+        let w: Vec<f64> = [0.1, 0.2, 0.3, 0.4]
+            .iter()
+            .map(|s| s + 0.5 * mean)
+            .collect();
+        let s2: Vec<f64> = [0.1f64, 0.2, 0.3, 0.4].iter().map(|s| s * s).collect();
+        let expect = 4.0 * s2.iter().sum::<f64>()
+            / (w.iter().sum::<f64>() * s2.iter().zip(&w).map(|(a, b)| a / b).sum::<f64>());
+        assert!((model - expect).abs() < 1e-3, "{model} {expect}");
+        let (_, none) = allocation_gains(&[0.3; 5], &est).unwrap();
+        assert!((none - 1.0).abs() < 1e-4, "{none}");
+        assert!(allocation_gains(&[0.1; 3], &est).is_none());
     }
 }

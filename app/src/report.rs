@@ -617,22 +617,27 @@ pub fn markdown(rep: &Report) -> String {
         let _ = writeln!(
             s,
             "Predicted deviation of one ray (the model's σ̂, what the ray counts follow) against the \
-             reference's measured per-pixel deviation:\n\n\
-             | configuration | pixels | rank correlation | log correlation | median predicted/measured |\n\
-             |---|---|---|---|---|"
+             reference's measured per-pixel deviation; and the ray gain at equal error that per-pixel \
+             counts buy where the error is each pixel's variance: the best (Neyman's allocation on the \
+             measured deviations, which no per-pixel counts exceed) and the model's (its first-round \
+             weights). A gain beyond the best needs a reconstruction across pixels.\n\n\
+             | configuration | pixels | rank correlation | log correlation | median predicted/measured | per-pixel counts' gain: best / the model's |\n\
+             |---|---|---|---|---|---|"
         );
         for c in &rep.configs {
             if let Some(p) = &c.prediction {
                 let _ = writeln!(
                     s,
-                    "| {}° d {} light {} | {} | {:.2} | {:.2} | {:.2} |",
+                    "| {}° d {} light {} | {} | {:.2} | {:.2} | {:.2} | {:.2} / {:.2} |",
                     c.view_deg,
                     c.distance,
                     c.light,
                     p.pixels,
                     p.rank_correlation,
                     p.log_correlation,
-                    p.median_ratio
+                    p.median_ratio,
+                    p.best_allocation_gain,
+                    p.predicted_allocation_gain
                 );
             }
         }
