@@ -296,6 +296,46 @@ mod tests {
         }
     }
 
+    /// The fast march (Illinois refinement) finds the reference march's crossings (bisection):
+    /// the same number on every line through a bumpy sphere, torus and cube, each within the
+    /// refinements' brackets of the other, and the same first hit.
+    #[test]
+    fn the_fast_march_finds_the_reference_crossings() {
+        let cube = BaseShape::Mesh(std::sync::Arc::new(
+            crate::object::mesh::TriMesh::from_obj(&crate::object::cube_obj()).unwrap(),
+        ));
+        let mut rng = 9u64;
+        for shape in [shapes()[0].clone(), shapes()[1].clone(), cube] {
+            let fast = object(shape.clone());
+            let reference = fast.clone().with_march(March::Reference);
+            let r = fast.bounding_radius();
+            let mut total = 0;
+            for _ in 0..200 {
+                let u = DVec3::new(
+                    splitmix(&mut rng) - 0.5,
+                    splitmix(&mut rng) - 0.5,
+                    splitmix(&mut rng) - 0.5,
+                );
+                let d = u.normalize();
+                let across = d.any_orthonormal_pair().0 * (r * (2.0 * splitmix(&mut rng) - 1.0));
+                let o = across - d * (1.5 * r);
+                let a = fast.crossings(o, d, 3.0 * r);
+                let b = reference.crossings(o, d, 3.0 * r);
+                assert_eq!(a.len(), b.len(), "{shape:?}: {o} {d}");
+                for (p, q) in a.iter().zip(&b) {
+                    assert!((*p - *q).length() < 1e-7, "{shape:?}: {p} vs {q}");
+                }
+                total += a.len();
+                match (fast.trace(o, d), reference.trace(o, d)) {
+                    (Some(x), Some(y)) => assert!((x.t - y.t).abs() < 1e-7),
+                    (None, None) => {}
+                    (x, y) => panic!("{shape:?}: {x:?} vs {y:?}"),
+                }
+            }
+            assert!(total > 200, "{shape:?}: {total} crossings");
+        }
+    }
+
     /// Without relief the trace is the exact intersection with the sphere.
     #[test]
     fn a_flat_sphere_is_hit_where_the_formula_says() {
