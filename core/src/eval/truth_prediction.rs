@@ -110,13 +110,55 @@ impl Evaluator {
                 (mean, if sd.is_finite() { sd } else { 0.0 })
             })
             .collect();
-        TruthPrediction {
+        let mut out = TruthPrediction {
             width: w,
             height: h,
             mean: pixels.iter().map(|p| p.0).collect(),
             sd: pixels.iter().map(|p| p.1).collect(),
-        }
+        };
+        out.sd = pixel_spread(&out.luminance(), &out.sd, w, h);
+        out
     }
+}
+
+/// One ray's deviation with the image's own variation across the pixel added (#18 §1): the
+/// footprint's statistics ([`Evaluator::predicted_ray_moments`]) hold what varies *within* the
+/// level-of-detail footprint; a truth ray also lands anywhere in the pixel, where the expected
+/// radiance itself varies: the resolved relief, the shading of a curved object, a silhouette or
+/// the horizon, where the sky (0) meets the surface. Over a box pixel a ramp of D per pixel
+/// spreads by `D²/12` per axis [BSSBH13 Sec. 2.4: the integrand's variance over the pixel
+/// footprint]; D is the larger one-sided difference of the predicted `mean` luminance along the
+/// axis (neighbours outside the image left out), so a step to the sky counts whole on the pixel on
+/// either side of it (a pixel half covered spreads by `D²/4`: this is a lower estimate there).
+/// Returns `√(sd² + (D_x² + D_y²)/12)` per pixel; non-finite inputs count as 0. Sizes that do not
+/// match return `sd` unchanged.
+pub fn pixel_spread(mean: &[f64], sd: &[f64], width: usize, height: usize) -> Vec<f64> {
+    if mean.len() != width * height || sd.len() != mean.len() {
+        return sd.to_vec();
+    }
+    let clean = |x: f64| if x.is_finite() { x } else { 0.0 };
+    let at = |x: usize, y: usize| clean(mean[y * width + x]);
+    (0..width * height)
+        .map(|p| {
+            let (x, y) = (p % width, p / width);
+            let c = at(x, y);
+            let mut d = [0.0f64; 2];
+            if x > 0 {
+                d[0] = d[0].max((c - at(x - 1, y)).abs());
+            }
+            if x + 1 < width {
+                d[0] = d[0].max((at(x + 1, y) - c).abs());
+            }
+            if y > 0 {
+                d[1] = d[1].max((c - at(x, y - 1)).abs());
+            }
+            if y + 1 < height {
+                d[1] = d[1].max((at(x, y + 1) - c).abs());
+            }
+            let own = clean(sd[p]).max(0.0);
+            (own * own + (d[0] * d[0] + d[1] * d[1]) / 12.0).sqrt()
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -142,6 +184,8 @@ mod tests {
         let (w, h) = (12u32, 10u32);
         let pred = p.predict_truth(&camera, (w, h), wi);
         assert_eq!((pred.width, pred.height), (12, 10));
+        // What a pixel's deviation holds beyond its footprint's: the image's spread across it.
+        let spread = pixel_spread(&pred.luminance(), &vec![0.0; pred.sd.len()], 12, 10);
         let lifted = p.surface.clear_camera(&camera);
         let mut sky = 0;
         for y in 0..h {
@@ -154,7 +198,7 @@ mod tests {
                 }
                 if lifted.plane_footprint(px, w, h).is_none() {
                     sky += 1;
-                    assert_eq!((pred.mean[i], pred.sd[i]), ([0.0; 3], 0.0));
+                    assert_eq!((pred.mean[i], pred.sd[i]), ([0.0; 3], spread[i]));
                 } else {
                     assert!(pred.sd[i] > 0.0, "pixel {i}");
                 }
@@ -166,11 +210,10 @@ mod tests {
         for y in 0..h {
             for x in 0..w {
                 let i = (y * w + x) as usize;
-                if pred.sd[i] == 0.0 {
-                    continue;
-                }
                 let px = DVec2::new(f64::from(x) + 0.5, f64::from(y) + 0.5);
-                let (_, cov) = lifted.plane_footprint(px, w, h).unwrap();
+                let Some((_, cov)) = lifted.plane_footprint(px, w, h) else {
+                    continue;
+                };
                 let ray = lifted.ray(px, w, h);
                 let (cfg, _) = p
                     .pixel_query(
@@ -207,6 +250,7 @@ mod tests {
         let (w, h) = (10u32, 8u32);
         let shape = Shape::Cylinder { radius };
         let pred = p.predict_truth_of(shape, &camera, (w, h), wi);
+        let spread = pixel_spread(&pred.luminance(), &vec![0.0; pred.sd.len()], 10, 8);
         let (mut beside, mut xs, mut ys) = (0, vec![], vec![]);
         for y in 0..h {
             for x in 0..w {
@@ -219,7 +263,7 @@ mod tests {
                 let Some((o, d, wl, fp, _)) = p.cylinder_query(radius, &camera, px, (w, h), wi)
                 else {
                     beside += 1;
-                    assert_eq!((pred.mean[i], pred.sd[i]), ([0.0; 3], 0.0));
+                    assert_eq!((pred.mean[i], pred.sd[i]), ([0.0; 3], spread[i]));
                     continue;
                 };
                 let Some((cfg, _)) = p.pixel_query(o, d, wl, fp) else {
@@ -239,6 +283,30 @@ mod tests {
         // a linear one.
         let r = spearman(&xs, &ys);
         assert!(r > 0.5, "rank correlation {r} over {} pixels", xs.len());
+    }
+
+    /// The pixel spread: a ramp of 0.3 a pixel along x adds 0.09/12 to every pixel's variance
+    /// (one-sided at the borders); a step of 1 between two columns adds 1/12 on both sides of it
+    /// and nothing beyond; a flat image keeps its deviations; NaN counts as 0.
+    #[test]
+    fn the_pixel_spread_adds_the_images_own_variation() {
+        let (w, h) = (5, 3);
+        let ramp: Vec<f64> = (0..w * h).map(|p| 0.3 * (p % w) as f64).collect();
+        let sd = vec![0.2; w * h];
+        for v in pixel_spread(&ramp, &sd, w, h) {
+            assert!((v * v - (0.04 + 0.09 / 12.0)).abs() < 1e-12, "{v}");
+        }
+        let step: Vec<f64> = (0..w * h).map(|p| if p % w < 2 { 0.0 } else { 1.0 }).collect();
+        let out = pixel_spread(&step, &vec![0.0; w * h], w, h);
+        for p in 0..w * h {
+            let want = if p % w == 1 || p % w == 2 { 1.0 / 12.0 } else { 0.0 };
+            assert!((out[p] * out[p] - want).abs() < 1e-12, "{p}: {}", out[p]);
+        }
+        assert_eq!(pixel_spread(&vec![0.7; w * h], &sd, w, h), sd);
+        let mut nan = vec![0.0; w * h];
+        nan[7] = f64::NAN;
+        assert!(pixel_spread(&nan, &sd, w, h).iter().all(|v| v.is_finite()));
+        assert_eq!(pixel_spread(&ramp[..3], &sd, w, h), sd);
     }
 
     /// Degenerate cameras and images predict zeros, never NaN.
