@@ -480,30 +480,36 @@ mod tests {
         assert!((a.time_gain(&u) - 8.0).abs() < 1e-9);
     }
 
-    #[test]
-    fn the_prediction_check_ranks_and_scales() {
-        use lodestone_render::truth_noise::SampleMoments;
-        // Four grey pixels of 4 rays with per-ray deviations 0.1, 0.2, 0.3, 0.4 (sums 4·0.5,
-        // squared sums 3s² + 4·0.25); predicted twice those in the same order, and one pixel
-        // with one ray (left out).
-        let sds = [0.1, 0.2, 0.3, 0.4];
-        let mut pixels: Vec<[f32; 4]> = vec![[2.0, 2.0, 2.0, 4.0]; 4];
+    /// Grey pixels of 4 rays with per-ray deviations `sds` (sums 4·0.5, squared sums 3s² +
+    /// 4·0.25), then one pixel of one ray: a truth image and its squared sums.
+    fn grey_pixels(sds: &[f64]) -> (LinearImage, lodestone_render::truth_noise::SampleMoments) {
+        let mut pixels: Vec<[f32; 4]> = vec![[2.0, 2.0, 2.0, 4.0]; sds.len()];
         let mut sum_sq: Vec<[f32; 4]> = sds
             .iter()
             .map(|s| [(3.0 * s * s + 1.0) as f32; 4])
             .collect();
         pixels.push([0.5, 0.5, 0.5, 1.0]);
         sum_sq.push([0.25; 4]);
-        let img = LinearImage {
-            width: 5,
-            height: 1,
-            pixels,
-        };
-        let moments = SampleMoments {
-            width: 5,
-            height: 1,
-            sum_sq,
-        };
+        let width = sds.len() as u32 + 1;
+        (
+            LinearImage {
+                width,
+                height: 1,
+                pixels,
+            },
+            lodestone_render::truth_noise::SampleMoments {
+                width,
+                height: 1,
+                sum_sq,
+            },
+        )
+    }
+
+    #[test]
+    fn the_prediction_check_ranks_and_scales() {
+        // Deviations 0.1–0.4, predicted twice those in the same order, and one pixel with one
+        // ray (left out).
+        let (img, moments) = grey_pixels(&[0.1, 0.2, 0.3, 0.4]);
         let est = TruthEstimate::new(&img, &moments).unwrap();
         let predicted = [0.2, 0.4, 0.6, 0.8, 1.0];
         let c = prediction_check(&predicted, &est).unwrap();
@@ -524,35 +530,14 @@ mod tests {
     /// gains less than the best by its defensive share, a flat one nothing.
     #[test]
     fn allocation_gains_follow_neyman() {
-        use lodestone_render::truth_noise::SampleMoments;
-        let build = |sds: &[f64]| {
-            let mut pixels: Vec<[f32; 4]> = vec![[2.0, 2.0, 2.0, 4.0]; sds.len()];
-            let mut sum_sq: Vec<[f32; 4]> = sds
-                .iter()
-                .map(|s| [(3.0 * s * s + 1.0) as f32; 4])
-                .collect();
-            pixels.push([0.5, 0.5, 0.5, 1.0]);
-            sum_sq.push([0.25; 4]);
-            let img = LinearImage {
-                width: sds.len() as u32 + 1,
-                height: 1,
-                pixels,
-            };
-            let moments = SampleMoments {
-                width: sds.len() as u32 + 1,
-                height: 1,
-                sum_sq,
-            };
-            (img, moments)
-        };
-        let (img, moments) = build(&[0.2; 4]);
+        let (img, moments) = grey_pixels(&[0.2; 4]);
         let flat = TruthEstimate::new(&img, &moments).unwrap();
         let (best, model) = allocation_gains(&[0.2, 0.2, 0.2, 0.2, 0.0], &flat).unwrap();
         assert!(
             (best - 1.0).abs() < 1e-4 && (model - 1.0).abs() < 1e-4,
             "{best} {model}"
         );
-        let (img, moments) = build(&[0.1, 0.2, 0.3, 0.4]);
+        let (img, moments) = grey_pixels(&[0.1, 0.2, 0.3, 0.4]);
         let est = TruthEstimate::new(&img, &moments).unwrap();
         let (best, model) = allocation_gains(&[0.1, 0.2, 0.3, 0.4, 0.0], &est).unwrap();
         assert!((best - 1.2).abs() < 1e-3, "{best}");

@@ -296,10 +296,16 @@ mod tests {
         for v in pixel_spread(&ramp, &sd, w, h) {
             assert!((v * v - (0.04 + 0.09 / 12.0)).abs() < 1e-12, "{v}");
         }
-        let step: Vec<f64> = (0..w * h).map(|p| if p % w < 2 { 0.0 } else { 1.0 }).collect();
+        let step: Vec<f64> = (0..w * h)
+            .map(|p| if p % w < 2 { 0.0 } else { 1.0 })
+            .collect();
         let out = pixel_spread(&step, &vec![0.0; w * h], w, h);
         for p in 0..w * h {
-            let want = if p % w == 1 || p % w == 2 { 1.0 / 12.0 } else { 0.0 };
+            let want = if p % w == 1 || p % w == 2 {
+                1.0 / 12.0
+            } else {
+                0.0
+            };
             assert!((out[p] * out[p] - want).abs() < 1e-12, "{p}: {}", out[p]);
         }
         assert_eq!(pixel_spread(&vec![0.7; w * h], &sd, w, h), sd);
