@@ -219,13 +219,21 @@ fn ground_truth_matches_the_cpu_ray_tracer_on_a_far_patch() {
 fn cylinder_views_match_core() {
     let Some(r) = renderer() else { return };
     for name in ["default.ron", "snake-skin.ron"] {
-        cylinder_views_match_core_for(&r, name);
+        cylinder_views_match_core_for(&r, name, [0.0, 0.0]);
     }
+    // The cylinder's top line passes through the camera's target, its relief read at the surface
+    // coordinates plus the target (the GPU moves its origin and noise phases there): core's
+    // analytic views and their prediction followed a cylinder through the origin instead, a few
+    // pixels off (the report's cylinder, target (0.3, 0.7), read a rank correlation of 0.2 between
+    // predicted and measured deviation).
+    cylinder_views_match_core_for(&r, "default.ron", [0.3, 0.7]);
 }
 
 /// On the cylinder the slope colour and the environment are looked up at world normals (the
 /// tangent frame turns with the surface): snake-skin checks that the GPU turns them like core.
-fn cylinder_views_match_core_for(r: &Renderer, name: &str) {
+/// Ground truth is compared only with the target at the origin (core's ray tracer takes rays
+/// around a cylinder through the origin).
+fn cylinder_views_match_core_for(r: &Renderer, name: &str, target: [f64; 2]) {
     let m = preset(name);
     let p = Evaluator::new(&m).unwrap();
     let radius = 1.5;
@@ -233,7 +241,7 @@ fn cylinder_views_match_core_for(r: &Renderer, name: &str) {
         elevation_deg: 55.0,
         azimuth_deg: 70.0,
         distance: 6.0,
-        target: [0.0, 0.0],
+        target,
         fov_deg: 45.0,
     };
     let light = direction(0.8, 2.5);
@@ -285,6 +293,9 @@ fn cylinder_views_match_core_for(r: &Renderer, name: &str) {
         sky > 50 && sky < (w * h) as usize,
         "the cylinder and the sky are both in view: {sky}"
     );
+    if target != [0.0, 0.0] {
+        return;
+    }
     // Ground truth: the GPU averages 16 Gaussian-jittered rays per pixel (its pixel filter), core
     // traces 16 rays per pixel through the same filter (a 4×4 stratified grid mapped by
     // Box–Muller); over the image both estimate the same filtered radiance of the same geometry

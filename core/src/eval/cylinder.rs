@@ -94,14 +94,21 @@ impl Evaluator {
         (width, height): (u32, u32),
         wi: DVec3,
     ) -> Option<(DVec3, DVec3, DVec3, Footprint, DMat3)> {
-        let camera = &self.surface.clear_cylinder_camera(camera, r);
+        // The cylinder's top line passes through the camera's target: work relative to it, the
+        // surface coordinates moved by it (`Surface::clear_cylinder_camera`, the GPU's view).
+        let anchor = DVec2::from(camera.target);
+        let lifted = self.surface.clear_cylinder_camera(camera, r);
+        let camera = &Camera {
+            target: [lifted.target[0] - anchor.x, lifted.target[1] - anchor.y],
+            ..lifted
+        };
         let ray = camera.ray(p, width, height);
         let (t, _) = intersect(r, r, ray.origin, ray.dir)?;
         let hit = ray.origin + ray.dir * t;
         let (u, v, _, phi) = to_surface(r, hit);
         let fr = frame(phi);
         let cov = camera.tangent_footprint(p, width, height, hit, fr)?;
-        let uv = DVec2::new(u, v);
+        let uv = DVec2::new(u, v) + anchor;
         let o = to_tangent(ray.origin, hit, uv, fr);
         let d = local(ray.dir, fr);
         let m = DMat3::from_cols(fr.0, fr.1, fr.2);

@@ -118,17 +118,23 @@ impl Surface {
         camera.clear_of(self.height(DVec2::new(e.x, e.y)) + EYE_MARGIN * self.h_max)
     }
 
-    /// [`Surface::clear_camera`] for the cylinder of radius `r` ([`crate::scene::cylinder`]): the
+    /// [`Surface::clear_camera`] for the cylinder of radius `r` ([`crate::scene::cylinder`])
+    /// whose top line passes through `camera`'s target (the views' cylinder: its coordinates are
+    /// taken relative to the target, and its surface coordinates `(u, v)` read the relief at
+    /// `(u, v) + target`, as the GPU's, whose origin and noise phases are moved to the target): the
     /// eye lifted straight up until its distance from the axis is `EYE_MARGIN · h_max` more than
     /// the displaced radius `r + h(u, v)` at its own surface coordinates. Lifting moves `v`, so the
     /// height is looked up again, three times at most (each step continuous in the camera). An eye
-    /// beside the cylinder (|y| beyond the radius it needs) is left as it is: it is outside.
+    /// beside the cylinder (|y| beyond the radius it needs) is left as it is: it is outside. The
+    /// cylinder stays where the given camera's target put it.
     pub fn clear_cylinder_camera(&self, camera: &Camera, r: f64) -> Camera {
+        let anchor = DVec3::new(camera.target[0], camera.target[1], 0.0);
         let mut c = *camera;
         for _ in 0..3 {
-            let e = c.eye();
+            let e = c.eye() - anchor;
             let (u, v, rho, _) = crate::scene::cylinder::to_surface(r, e);
-            let need = r + self.height(DVec2::new(u, v)) + EYE_MARGIN * self.h_max;
+            let need =
+                r + self.height(DVec2::new(u + anchor.x, v + anchor.y)) + EYE_MARGIN * self.h_max;
             if !(rho < need && need > e.y.abs()) {
                 break;
             }
