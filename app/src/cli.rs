@@ -353,6 +353,15 @@ pub enum Command {
         /// Radius of the cylinder (world units, 0.01 to 10⁴).
         #[arg(long, default_value_t = 2.0, value_parser = radius)]
         radius: f64,
+        /// Also compare the whole-object views (#19: nearest voxels, alpha blended, masks, ground
+        /// truth) on the unit sphere at these camera distances (comma-separated, each 0.02 to
+        /// 5000), at the report's size and with `lodestone object`'s defaults otherwise: a section
+        /// of report.md and its strips in OUT/objects. Empty (the default) leaves it out.
+        #[arg(long, value_delimiter = ',', value_parser = distance)]
+        object_distances: Vec<f64>,
+        /// The sphere's octree depth for `--object-distances` (2 to 10).
+        #[arg(long, default_value_t = 7, value_parser = clap::value_parser!(u32).range(2..=10))]
+        object_depth: u32,
     },
     /// Run stiff and extreme cases (grazing angles, σ → 0 and 1e6, anisotropy 1e±6, L to 1e12, step
     /// maps, vertical transfer segments, constant images) through core f64, its f32 mirror and the

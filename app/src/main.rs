@@ -402,6 +402,8 @@ fn run(cli: Cli) -> Result<()> {
             retry_cut_rays,
             shape,
             radius,
+            object_distances,
+            object_depth,
         }) => {
             check_output(&out, true)?;
             let shape = shape.shape(radius).map_err(anyhow::Error::msg)?;
@@ -419,6 +421,28 @@ fn run(cli: Cli) -> Result<()> {
             let rep = report::run(&preset, &opts)?;
             report::write(&rep, &out)?;
             out!("{}", report::markdown(&rep));
+            if !object_distances.is_empty() {
+                // The whole object (#19): `lodestone object`'s sweep on the unit sphere, its
+                // table appended to report.md.
+                let sweep = object_cmd::Options {
+                    depth: object_depth,
+                    size,
+                    distances: object_distances,
+                    out: Some(out.join("objects")),
+                    ..object_cmd::Options::sphere_defaults()
+                };
+                let table = object_cmd::run(material, &sweep)?;
+                let section = format!(
+                    "\n## Whole object (#19): voxel views against ground truth\n\n\
+                     `lodestone object` on the unit sphere, octree depth {object_depth}, at the \
+                     report's size (strips in `objects/`).\n\n{table}\n"
+                );
+                let md = out.join("report.md");
+                let mut text = std::fs::read_to_string(&md)?;
+                text.push_str(&section);
+                preset_io::write_atomic(&md, &text)?;
+                out!("{section}");
+            }
             outln!(
                 "wrote report.json, report.md and the charts (error_vs_time, error_vs_view, error_vs_rays; SVG and PNG) to {}",
                 out.display()

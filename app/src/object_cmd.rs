@@ -66,6 +66,29 @@ pub struct Options {
     pub max_rays: usize,
 }
 
+impl Options {
+    /// `lodestone object`'s defaults (the unit sphere, depth 7, 160 × 120, distances 8, 4, 2,
+    /// camera 60°/30°, sun 37°/−37°, 64 rays refined to 0.5%, shadows, CPU only, no strips).
+    pub fn sphere_defaults() -> Self {
+        Self {
+            shape: BaseShape::Sphere { radius: 1.0 },
+            depth: 7,
+            size: (160, 120),
+            distances: vec![8.0, 4.0, 2.0],
+            view: (60.0, 30.0),
+            light: (37.0, -37.0),
+            rays: 64,
+            out: None,
+            shadows: true,
+            gpu: false,
+            lens: 0.0,
+            focus: None,
+            truth_se: 0.005,
+            max_rays: 16384,
+        }
+    }
+}
+
 /// The base shape named on the command line; a mesh is read and checked here.
 pub fn shape(kind: &str, mesh: Option<&Path>, radius: f64, minor: f64) -> Result<BaseShape> {
     let shape = match kind {

@@ -333,8 +333,8 @@ fn stability_passes_and_reports_json() {
 }
 
 /// `lodestone report --shape cylinder`: the configurations view the cylinder (the report says so),
-/// its adaptive ground truth is predicted there and spends its budget; a bad radius is a usage
-/// error.
+/// its adaptive ground truth is predicted there and spends its budget, and `--object-distances`
+/// adds the whole object's voxel views (#19) as a section; a bad radius is a usage error.
 #[test]
 fn report_on_the_cylinder() {
     let dir = std::env::temp_dir().join(format!("lodestone-report-cyl-{}", std::process::id()));
@@ -359,6 +359,10 @@ fn report_on_the_cylinder() {
             "cylinder".into(),
             "--radius".into(),
             radius.into(),
+            "--object-distances".into(),
+            "6".into(),
+            "--object-depth".into(),
+            "4".into(),
         ]
     };
     let bad = lodestone(&args("-1").iter().map(String::as_str).collect::<Vec<_>>());
@@ -377,6 +381,11 @@ fn report_on_the_cylinder() {
     let rep: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("report.json")).unwrap()).unwrap();
     assert_eq!(rep["object"], "cylinder of radius 1");
+    // The whole object (#19) as a section of report.md, its strip beside it.
+    let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    assert!(md.contains("## Whole object (#19)"), "{md}");
+    assert!(md.contains("| 6 |"), "{md}");
+    assert!(dir.join("objects").join("object-d6.png").is_file());
     for c in rep["configs"].as_array().unwrap() {
         let adaptive = c["adaptive"].as_array().unwrap();
         assert_eq!(adaptive.len(), 6, "{c}");
