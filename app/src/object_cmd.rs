@@ -68,7 +68,8 @@ pub struct Options {
 
 impl Options {
     /// `lodestone object`'s defaults (the unit sphere, depth 7, 160 × 120, distances 8, 4, 2,
-    /// camera 60°/30°, sun 37°/−37°, 64 rays refined to 0.5%, shadows, CPU only, no strips).
+    /// camera 60°/30°, sun 37°/−37°, 64 rays refined to 0.5%, shadows, CPU only, no strips):
+    /// equal to what the command parses with no options (tested).
     pub fn sphere_defaults() -> Self {
         Self {
             shape: BaseShape::Sphere { radius: 1.0 },
@@ -321,4 +322,49 @@ fn strip(images: &ObjectImages) -> image::RgbImage {
         }
     }
     img
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::{Cli, Command};
+    use clap::Parser;
+
+    /// [`Options::sphere_defaults`] is what `lodestone object` parses with no options (the report's
+    /// object section relies on it), so the two cannot drift apart.
+    #[test]
+    fn the_sphere_defaults_are_the_commands() {
+        let Some(Command::Object {
+            depth,
+            size,
+            distances,
+            view_deg,
+            view_azimuth_deg,
+            light_deg,
+            light_azimuth_deg,
+            rays,
+            no_shadows,
+            gpu,
+            lens,
+            focus,
+            truth_se,
+            max_rays,
+            radius,
+            ..
+        }) = Cli::parse_from(["lodestone", "object"]).command
+        else {
+            panic!("not the object command");
+        };
+        let d = Options::sphere_defaults();
+        assert_eq!(d.shape, BaseShape::Sphere { radius });
+        assert_eq!((d.depth, d.size, d.distances), (depth, size, distances));
+        assert_eq!(d.view, (view_deg, view_azimuth_deg));
+        assert_eq!(d.light, (light_deg, light_azimuth_deg));
+        assert_eq!((d.rays, d.max_rays), (rays as usize, max_rays as usize));
+        assert_eq!(
+            (d.shadows, d.gpu, d.lens, d.focus),
+            (!no_shadows, gpu, lens, focus)
+        );
+        assert_eq!(d.truth_se, truth_se / 100.0);
+    }
 }
