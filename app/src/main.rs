@@ -429,7 +429,7 @@ fn run(cli: Cli) -> Result<()> {
                     size,
                     distances: object_distances,
                     out: Some(out.join("objects")),
-                    ..object_cmd::Options::sphere_defaults()
+                    ..object_cmd::Options::sphere_defaults()?
                 };
                 let table = object_cmd::run(material, &sweep)?;
                 let section = format!(
@@ -448,43 +448,8 @@ fn run(cli: Cli) -> Result<()> {
                 out.display()
             );
         }
-        Some(Command::Object {
-            shape,
-            mesh,
-            radius,
-            minor,
-            depth,
-            size,
-            distances,
-            view_deg,
-            view_azimuth_deg,
-            light_deg,
-            light_azimuth_deg,
-            rays,
-            out,
-            no_shadows,
-            gpu,
-            lens,
-            focus,
-            truth_se,
-            max_rays,
-        }) => {
-            let opts = object_cmd::Options {
-                shadows: !no_shadows,
-                gpu,
-                lens,
-                focus,
-                truth_se: truth_se / 100.0,
-                max_rays: max_rays as usize,
-                shape: object_cmd::shape(shape.name(), mesh.as_deref(), radius, minor)?,
-                depth,
-                size,
-                distances,
-                view: (view_deg, view_azimuth_deg),
-                light: (light_deg, light_azimuth_deg),
-                rays: rays as usize,
-                out,
-            };
+        Some(cmd @ Command::Object { .. }) => {
+            let opts = object_cmd::Options::from_command(cmd)?;
             out!("{}", object_cmd::run(material, &opts)?);
         }
         Some(Command::Adapter) => {

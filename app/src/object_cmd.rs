@@ -67,26 +67,58 @@ pub struct Options {
 }
 
 impl Options {
+    /// The options of a parsed `lodestone object` command (its mesh read and checked); an error
+    /// for any other command.
+    pub fn from_command(cmd: crate::cli::Command) -> Result<Self> {
+        let crate::cli::Command::Object {
+            shape,
+            mesh,
+            radius,
+            minor,
+            depth,
+            size,
+            distances,
+            view_deg,
+            view_azimuth_deg,
+            light_deg,
+            light_azimuth_deg,
+            rays,
+            out,
+            no_shadows,
+            gpu,
+            lens,
+            focus,
+            truth_se,
+            max_rays,
+        } = cmd
+        else {
+            anyhow::bail!("not the object command");
+        };
+        Ok(Self {
+            shadows: !no_shadows,
+            gpu,
+            lens,
+            focus,
+            truth_se: truth_se / 100.0,
+            max_rays: max_rays as usize,
+            shape: self::shape(shape.name(), mesh.as_deref(), radius, minor)?,
+            depth,
+            size,
+            distances,
+            view: (view_deg, view_azimuth_deg),
+            light: (light_deg, light_azimuth_deg),
+            rays: rays as usize,
+            out,
+        })
+    }
+
     /// `lodestone object`'s defaults (the unit sphere, depth 7, 160 × 120, distances 8, 4, 2,
     /// camera 60°/30°, sun 37°/−37°, 64 rays refined to 0.5%, shadows, CPU only, no strips):
-    /// equal to what the command parses with no options (tested).
-    pub fn sphere_defaults() -> Self {
-        Self {
-            shape: BaseShape::Sphere { radius: 1.0 },
-            depth: 7,
-            size: (160, 120),
-            distances: vec![8.0, 4.0, 2.0],
-            view: (60.0, 30.0),
-            light: (37.0, -37.0),
-            rays: 64,
-            out: None,
-            shadows: true,
-            gpu: false,
-            lens: 0.0,
-            focus: None,
-            truth_se: 0.005,
-            max_rays: 16384,
-        }
+    /// what the command parses with no options.
+    pub fn sphere_defaults() -> Result<Self> {
+        use clap::Parser;
+        let cli = crate::cli::Cli::try_parse_from(["lodestone", "object"])?;
+        Self::from_command(cli.command.context("no command")?)
     }
 }
 
@@ -355,7 +387,7 @@ mod tests {
         else {
             panic!("not the object command");
         };
-        let d = Options::sphere_defaults();
+        let d = Options::sphere_defaults().unwrap();
         assert_eq!(d.shape, BaseShape::Sphere { radius });
         assert_eq!((d.depth, d.size, d.distances), (depth, size, distances));
         assert_eq!(d.view, (view_deg, view_azimuth_deg));
