@@ -13,7 +13,7 @@ use crate::{LinearImage, RenderError, Renderer, Scene, ViewTarget};
 use lodestone_core::eval::adaptive_window::{
     WindowOptions, WindowReconstruction, WindowSample, reconstruct,
 };
-use lodestone_core::eval::sampling_plan::SamplingPlan;
+use lodestone_core::eval::sampling_plan::{SamplingPlan, water_fill};
 use lodestone_core::eval::truth_prediction::TruthPrediction;
 
 /// The uniform share of an adaptive plan's allocation: rays go in proportion to
@@ -71,24 +71,24 @@ pub fn render_adaptive(
         .iter()
         .map(|s| s + DEFENSIVE * mean_sd)
         .collect();
-    let cap = |mut plan: SamplingPlan| {
-        for r in &mut plan.rays {
-            *r = (*r).min(opts.max_rays.max(1));
-        }
-        plan
-    };
     target.reset();
-    let first = cap(SamplingPlan::new(
+    let first = SamplingPlan::new(
         w,
         h,
         &guide,
         sd,
         opts.rays_per_pixel / 4.0,
         opts.step,
-    ));
+        opts.max_rays,
+    );
     renderer.draw_planned(target, material, scene, &first.rays);
-    let est: Vec<f64> = luminance(&target.read(renderer)?);
-    let plan = cap(first.refine(&est, sd, &guide, opts.rays_per_pixel));
+    let traced = target.read(renderer)?;
+    let est: Vec<f64> = luminance(&traced);
+    // The refinement weighs each corner's residual against its noise: the rays' own sample
+    // variance where they measured one, pooled with the prediction (as the progressive plan's).
+    let measured = luminance_variances(&traced, &target.read_moments(renderer)?);
+    let dev = pixel_deviations(sd, &measured);
+    let plan = first.refine(&est, &dev, &guide, opts.rays_per_pixel, opts.max_rays);
     renderer.draw_planned(target, material, scene, &plan.rays);
     let shaded = target.read(renderer)?;
     let channels: Vec<Vec<f64>> = (0..3)
@@ -216,43 +216,13 @@ pub fn progressive_counts(
     let floor: Vec<f64> = (0..n)
         .map(|p| f64::from(current.get(p).copied().unwrap_or(0).max(1)))
         .collect();
-    let cap: Vec<f64> = (0..n)
-        .map(|p| f64::from(max_rays.max(1)).max(floor[p]))
-        .collect();
+    let cap = vec![f64::from(max_rays.max(1)); n];
     let mean = if mean_rays.is_finite() {
         mean_rays.max(0.0)
     } else {
         0.0
     };
-    let total = (mean * n as f64).round();
-    let at = |lambda: f64| -> f64 {
-        (0..n)
-            .map(|p| (lambda * weight[p]).clamp(floor[p], cap[p]))
-            .sum()
-    };
-    // Σ clamp(λ w_p) is non-decreasing in λ: bisect for the λ that spends the total.
-    let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
-    while at(hi) < total && hi < 1e300 {
-        hi *= 2.0;
-    }
-    for _ in 0..100 {
-        let mid = 0.5 * (lo + hi);
-        if at(mid) < total {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    // Round with the error carried along the pixels, so the total stays within one ray.
-    let mut carry = 0.0;
-    (0..n)
-        .map(|p| {
-            let want = (hi * weight[p]).clamp(floor[p], cap[p]) + carry;
-            let r = want.round().clamp(floor[p], cap[p]);
-            carry = want - r;
-            r as u32
-        })
-        .collect()
+    water_fill(&weight, &floor, &cap, mean * n as f64)
 }
 
 /// Per pixel of a truth image and its squared sums: (rays, sample variance of their luminance),

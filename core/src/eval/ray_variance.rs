@@ -439,7 +439,7 @@ mod tests {
                         (&fm, &sdp, 2),
                         (&fm, &sdp, 4),
                     ] {
-                        let plan = SamplingPlan::new(w, h, mean_pred, sd_pred, rpp, step);
+                        let plan = SamplingPlan::new(w, h, mean_pred, sd_pred, rpp, step, u32::MAX);
                         // Uniform over `covered` pixels reaches an MSE with mean_var·n/(covered·mse)
                         // rays a covered pixel (its MSE is averaged over all n).
                         let per = plan.total_rays() as f64 / covered;
@@ -451,8 +451,15 @@ mod tests {
                             let guided = equal(plan.expected_mse(&mu, &sd, Some(&fm)));
                             // A posteriori: a quarter of the budget on the first plan, its
                             // estimates drawn around the reference, then the refined plan.
-                            let first =
-                                SamplingPlan::new(w, h, mean_pred, sd_pred, rpp / 4.0, step);
+                            let first = SamplingPlan::new(
+                                w,
+                                h,
+                                mean_pred,
+                                sd_pred,
+                                rpp / 4.0,
+                                step,
+                                u32::MAX,
+                            );
                             let mut rng = 0x5EED_u64 + step as u64;
                             let est: Vec<f64> = (0..w * h)
                                 .map(|q| {
@@ -462,7 +469,7 @@ mod tests {
                                             * crate::math::random::standard_normal(&mut rng)
                                 })
                                 .collect();
-                            let refined = first.refine(&est, sd_pred, &fm, rpp);
+                            let refined = first.refine(&est, sd_pred, &fm, rpp, u32::MAX);
                             let per_r = refined.total_rays() as f64 / covered;
                             let r = mean_var * covered
                                 / (n * refined.expected_mse(&mu, &sd, Some(&fm)))
