@@ -5,8 +5,11 @@
 //!
 //! Two passes: a quarter of the budget on the a priori plan (the lattice, the pixels it cannot
 //! interpolate, rays in proportion to the predicted deviation), then the a posteriori refinement
-//! ([`SamplingPlan::refine`]: cells whose measured residual from the prediction is not smooth are
-//! shaded whole) with the rest. Uniform sampling is `Renderer::draw` with the same total.
+//! ([`SamplingPlan::refine`]: cells whose measured residual from the prediction is not smooth,
+//! or where the realisation pooled over the neighbouring cells makes interpolating cost more than
+//! shading, are shaded whole) with the rest, the corners' noise from their rays' own sample
+//! variance pooled with the prediction ([`pixel_deviations`]). Uniform sampling is
+//! `Renderer::draw` with the same total.
 
 use crate::truth_noise::{SampleMoments, TruthEstimate};
 use crate::{LinearImage, RenderError, Renderer, Scene, ViewTarget};

@@ -20,15 +20,21 @@
 //!
 //! Uniform sampling is the plan with `step = 1` and equal σ̂.
 
-/// How many cells on each side of a lattice cell [`SamplingPlan::refine`] pools the realisation
-/// over: 5 × 5 cells, about 75 degrees of freedom, enough for a significance test, and local
-/// enough to follow how the footprint (and so the realisation) changes down a grazing image.
-pub const POOL_CELLS: usize = 2;
+/// How many rows of cells above and below a lattice cell [`SamplingPlan::refine`] pools the
+/// realisation over, across the whole width: the footprint, and so the realisation, changes down
+/// a view (with distance, and with the cylinder's curvature), hardly across it. Five rows of a
+/// 64-pixel-wide image at step 4 are 80 cells; a 5 × 5 window's 25 left the estimate's standard
+/// error at 0.57 of itself where the corners' noise equals the realisation, too loose to decide on.
+pub const POOL_ROWS: usize = 2;
 /// How many standard errors below its estimate [`SamplingPlan::refine`] takes the pooled
-/// realisation: about a 93% one-sided bound. At 2 the windows at an image's edges (fewer cells)
-/// never resolved a realisation that made interpolation nine times worse than shading; at 1, a
-/// noise-limited first pass shaded cells for nothing in two of eight trials, costing up to 47%.
-const LOWER_SE: f64 = 1.5;
+/// realisation where shading takes rays from other pixels: about a 96% one-sided bound. At about
+/// half that, a noise-limited first pass shaded cells for nothing in two of eight trials, costing
+/// up to 47%.
+const LOWER_SE: f64 = 1.75;
+
+/// The pooled spreads' standard error over what independent cells would give, for cells that
+/// share corners (√3; 1.73 simulated for independent corner residuals over 5 × 5 cells).
+const SHARED_CORNERS: f64 = 1.732_050_807_568_877_2;
 
 /// Which pixels a ground truth shades, with how many rays, and how the rest are reconstructed.
 #[derive(Clone, Debug, PartialEq)]
@@ -205,21 +211,26 @@ impl SamplingPlan {
     ///    Robust against the first pass's noise (four corners are three degrees of freedom), so
     ///    it catches what stands out: an edge, a glint the prediction missed.
     /// 2. **Pooled**: the realisation is a property of the surface and the footprint, not of one
-    ///    cell, so `κ = Σe/Σ s̄²` (s̄² the corners' mean one-ray variance) is pooled over the
-    ///    cells within [`POOL_CELLS`] of each, and taken at the lower end of its two-standard-error
-    ///    interval (`(Σe − 2·SE)/Σ s̄²`, at least 0): only a realisation the first pass resolved
-    ///    from its noise shades anything, and a marginal one little (the point estimate of a
-    ///    window that just passed a significance test is biased high, and shaded noise-limited
-    ///    images for nothing). With residuals independent from pixel to pixel, an interpolated pixel
-    ///    misses by `E[(r_p − Σ w_k r_k)²] = κ sd_p² (1 + Σ w_k²)`. A cell is worth shading when
-    ///    that bias, summed over its unshaded pixels, exceeds what shading them costs at equal
+    ///    cell, so its variance `ρ = Σe/m` is pooled over the m cells of the rows within
+    ///    [`POOL_ROWS`] of each. Where shading takes rays from other pixels it is taken at the lower end of its
+    ///    interval (`(Σe − LOWER_SE·SE)/m`, at least 0): only a realisation the first pass
+    ///    resolved from its noise shades anything, and a marginal one little (a window that just
+    ///    passed a significance test is biased high, and shaded noise-limited images for
+    ///    nothing). Where the caps leave rays unspent, shading costs only the pixel's own noise
+    ///    at the cap, and the point estimate decides (where it stands two standard errors out): a
+    ///    capped first pass rarely resolves the realisation it is deciding on. It is pooled as a
+    ///    variance, not relative to one ray's: where the relief is resolved the realisation is
+    ///    the relief itself, far above the rays' spread inside a pixel. With residuals
+    ///    independent from pixel to pixel, an interpolated pixel misses by
+    ///    `E[(r_p − Σ w_k r_k)²] = ρ (1 + Σ w_k²)`, plus the corners' noise `Σ w_k² sd_k²/n_k`.
+    ///    A cell is worth shading when that loss, summed over its unshaded pixels, exceeds what shading them costs at equal
     ///    total rays: each pixel's own noise `sd_p²/n_p` with Neyman's `n_p = sd_p/Λ`
     ///    (`Λ = Σ_shaded sd / budget`) plus what its rays take from the others, `sd_p Λ`; when the
     ///    shaded pixels are all at `max_rays` and cannot spend the budget, only the own noise
-    ///    `sd_p²/max_rays`. Cells are taken greedily, most bias per unit of `Σ sd` first.
+    ///    `sd_p²/max_rays`. Cells are taken greedily, most loss per unit of `Σ sd` first.
     ///
     /// So the lattice falls back to shading every pixel as the budget grows past what the
-    /// realisation allows (`κ·n̄ ≳ 1`), and spends rays the caps would leave unspent on more
+    /// realisation allows (`ρ ≳ sd²/n̄`), and spends rays the caps would leave unspent on more
     /// pixels. The refined plan's rays total `rays_per_pixel` a pixel over the image (less only
     /// where every shaded pixel is at `max_rays`), in proportion to `sd`, and no shaded pixel gets
     /// fewer than it already has (nor more than `max_rays` unless it had them).
@@ -249,11 +260,7 @@ impl SamplingPlan {
             let (cw, ch) = (xs.len().saturating_sub(1), ys.len().saturating_sub(1));
             // Per cell: its pixel ranges and, where its four corners are shaded, (e, s̄²).
             #[allow(clippy::type_complexity)]
-            let mut cells: Vec<(
-                (usize, usize),
-                (usize, usize),
-                Option<(f64, f64, f64)>,
-            )> = Vec::new();
+            let mut cells: Vec<((usize, usize), (usize, usize), Option<(f64, f64)>)> = Vec::new();
             for cy in ys.windows(2) {
                 for cx in xs.windows(2) {
                     let idx = [
@@ -272,8 +279,7 @@ impl SamplingPlan {
                             .map(|p| sd_at(*p).powi(2) / f64::from(self.rays[*p]))
                             .sum::<f64>()
                             / 4.0;
-                        let s2 = idx.iter().map(|p| sd_at(*p).powi(2)).sum::<f64>() / 4.0;
-                        (spread - noise, s2, noise)
+                        (spread - noise, noise)
                     });
                     cells.push(((cx[0], cx[1]), (cy[0], cy[1]), stat));
                 }
@@ -287,7 +293,7 @@ impl SamplingPlan {
             };
             // Rule 1, local.
             for &(xr, yr, stat) in &cells {
-                let Some((e, _, noise)) = stat else { continue };
+                let Some((e, noise)) = stat else { continue };
                 let sigma = [(xr.0, yr.0), (xr.1, yr.0), (xr.0, yr.1), (xr.1, yr.1)]
                     .iter()
                     .map(|(x, y)| sd_at(y * w + x))
@@ -299,32 +305,33 @@ impl SamplingPlan {
                     fill(&mut shaded, xr, yr);
                 }
             }
-            // Rule 2, pooled: κ per cell from its neighbourhood.
-            let kappa: Vec<f64> = (0..cells.len())
+            // Rule 2, pooled: the realisation's variance per cell from its neighbourhood.
+            // (lower bound, point estimate) per cell.
+            let realised: Vec<(f64, f64)> = (0..cells.len())
                 .map(|c| {
-                    let (i, j) = (c % cw.max(1), c / cw.max(1));
+                    let j = c / cw.max(1);
                     let mut es = Vec::new();
-                    let mut s2 = 0.0;
-                    for jj in j.saturating_sub(POOL_CELLS)..(j + POOL_CELLS + 1).min(ch) {
-                        for ii in i.saturating_sub(POOL_CELLS)..(i + POOL_CELLS + 1).min(cw) {
-                            if let Some((e, v, _)) = cells[jj * cw + ii].2 {
+                    for jj in j.saturating_sub(POOL_ROWS)..(j + POOL_ROWS + 1).min(ch) {
+                        for ii in 0..cw {
+                            if let Some((e, _)) = cells[jj * cw + ii].2 {
                                 es.push(e);
-                                s2 += v;
                             }
                         }
                     }
                     let m = es.len() as f64;
                     let total: f64 = es.iter().sum();
-                    if es.len() < 4 || !(s2 > 0.0) || !(total > 0.0) {
-                        return 0.0;
+                    if es.len() < 4 || !(total > 0.0) {
+                        return (0.0, 0.0);
                     }
                     let mean = total / m;
                     let var = es.iter().map(|e| (e - mean).powi(2)).sum::<f64>() / (m - 1.0);
-                    // The lower end of its two-standard-error interval. Neighbouring cells share
-                    // corners (each corner enters up to four spreads), so the sum has about a
-                    // quarter of m's degrees of freedom: its standard error is twice √(m·var).
-                    let se = 2.0 * (m * var).sqrt();
-                    (total - LOWER_SE * se).max(0.0) / s2
+                    // Neighbouring cells share corners (each corner enters up to four spreads):
+                    // for independent corners the sum's deviation is √3 times what independent
+                    // cells would give (1.73, simulated over 5 × 5 cells).
+                    let se = SHARED_CORNERS * (m * var).sqrt();
+                    let lower = (total - LOWER_SE * se).max(0.0) / m;
+                    let point = if total > 2.0 * se { mean } else { 0.0 };
+                    (lower, point)
                 })
                 .collect();
             // What interpolating a cell's unshaded pixels loses: the realisation's bias and the
@@ -337,7 +344,8 @@ impl SamplingPlan {
                     cap
                 }
             };
-            let open = |shaded: &[bool], c: usize, lambda: f64| -> (f64, Vec<usize>) {
+            let open = |shaded: &[bool], c: usize, lambda: f64, free: bool| -> (f64, Vec<usize>) {
+                let rho = if free { realised[c].1 } else { realised[c].0 };
                 let ((x0, x1), (y0, y1), _) = cells[c];
                 let mut loss = 0.0;
                 let mut pixels = Vec::new();
@@ -363,7 +371,7 @@ impl SamplingPlan {
                                 wk * wk * sk * sk / rays_for(sk, lambda)
                             })
                             .sum();
-                        loss += kappa[c] * sd_at(p).powi(2) * (1.0 + sum_w2) + noise;
+                        loss += rho * (1.0 + sum_w2) + noise;
                         pixels.push(p);
                     }
                 }
@@ -372,9 +380,9 @@ impl SamplingPlan {
             let mut sum_sd: f64 = (0..n).filter(|p| shaded[*p]).map(sd_at).sum();
             let mut count = shaded.iter().filter(|s| **s).count() as f64;
             let mut order: Vec<(usize, f64)> = (0..cells.len())
-                .filter(|c| kappa[*c] > 0.0)
+                .filter(|c| realised[*c].1 > 0.0)
                 .map(|c| {
-                    let (loss, pixels) = open(&shaded, c, sum_sd / budget);
+                    let (loss, pixels) = open(&shaded, c, 0.0, true);
                     let cost: f64 = pixels.iter().map(|p| sd_at(*p)).sum();
                     (c, loss / cost.max(f64::MIN_POSITIVE))
                 })
@@ -384,7 +392,7 @@ impl SamplingPlan {
             for (c, _) in order {
                 let lambda = sum_sd / budget;
                 let free = count * cap < budget;
-                let (loss, pixels) = open(&shaded, c, if free { 0.0 } else { lambda });
+                let (loss, pixels) = open(&shaded, c, if free { 0.0 } else { lambda }, free);
                 // Shading a pixel costs its own noise, and (unless the caps leave rays unspent)
                 // the noise its rays add to the others.
                 let cost: f64 = pixels
@@ -651,7 +659,7 @@ mod tests {
     }
 
     /// A first pass over a flat guide whose truth departs from it by an independent realisation
-    /// per pixel (variance κ·sd²), its estimates carrying their rays' noise.
+    /// per pixel (variance κ·sd², sd = 0.2), its estimates carrying their rays' noise.
     fn realisation(kappa: f64, rpp: f64, max_rays: u32, seed: u64) -> RealisationCase {
         let (w, h, sd) = (33, 33, 0.2);
         let mut rng = seed;
@@ -725,20 +733,34 @@ mod tests {
     }
 
     /// Rays the caps would leave unspent go to more pixels where the realisation says shading
-    /// them helps; with no realisation the lattice is kept, and what its caps cannot take is not
-    /// traced.
+    /// them helps; with no realisation the lattice is (nearly) kept, and what its caps cannot
+    /// take is not traced.
     #[test]
     fn capped_rays_spill_onto_more_pixels_only_where_it_helps() {
+        let mse = |c: &RealisationCase, plan: &SamplingPlan| {
+            plan.expected_mse(&c.truth, &c.sds, Some(c.guide.as_slice()))
+        };
         // κ = 0.1: an interpolated pixel misses by about 0.1·0.04·1.47 = 5.9e-3, a pixel shaded
         // with the cap's 64 rays by 0.04/64 = 6.3e-4.
         let spilled = realisation(0.1, 64.0, 64, 4);
         let shaded = spilled.refined.rays.iter().filter(|r| **r > 0).count();
-        // (Windows at the image's corners pool fewer cells, so their bound is looser.)
         assert!(shaded >= 1089 * 9 / 10, "{shaded}");
         assert!(spilled.refined.rays.iter().all(|r| *r <= 64));
         assert!(spilled.refined.total_rays() as f64 > 60.0 * 1089.0);
-        let quiet = realisation(0.0, 64.0, 64, 4);
-        assert_eq!(quiet.refined.rays.iter().filter(|r| **r > 0).count(), 81);
-        assert_eq!(quiet.refined.total_rays(), 81 * 64);
+        let kept = spilled
+            .first
+            .refine(&spilled.guide, &spilled.sds, &spilled.guide, 64.0, 64);
+        assert!(mse(&spilled, &spilled.refined) < 0.3 * mse(&spilled, &kept));
+        let mut ratios = Vec::new();
+        for seed in 1..=16 {
+            let quiet = realisation(0.0, 64.0, 64, seed);
+            let kept = quiet
+                .first
+                .refine(&quiet.guide, &quiet.sds, &quiet.guide, 64.0, 64);
+            assert_eq!(kept.total_rays(), 81 * 64);
+            ratios.push(mse(&quiet, &quiet.refined) / mse(&quiet, &kept));
+        }
+        let mean = ratios.iter().sum::<f64>() / ratios.len() as f64;
+        assert!(mean < 1.05 && ratios.iter().all(|r| *r < 1.3), "{ratios:?}");
     }
 }
