@@ -145,6 +145,22 @@ fn allocate(
     water_fill(&weight, &low, &cap, budget)
 }
 
+/// A lattice cell of [`SamplingPlan::refine`]: its pixel ranges (lattice corners included) and,
+/// where its four corners are shaded, their residuals' spread.
+#[derive(Clone, Copy)]
+struct Cell {
+    xs: (usize, usize),
+    ys: (usize, usize),
+    spread: Option<Spread>,
+}
+
+/// The corners' residuals' sample variance beyond their mean noise (`excess`), and that noise.
+#[derive(Clone, Copy)]
+struct Spread {
+    excess: f64,
+    noise: f64,
+}
+
 /// The lattice coordinates bracketing `i` on a `step` lattice of `n` pixels, and `i`'s weight on
 /// the upper one: the last pixel is a lattice point too.
 fn bracket(i: usize, step: usize, n: usize) -> (usize, usize, f64) {
@@ -258,9 +274,7 @@ impl SamplingPlan {
         if n > 0 {
             let (xs, ys) = (lattice(w), lattice(h));
             let (cw, ch) = (xs.len().saturating_sub(1), ys.len().saturating_sub(1));
-            // Per cell: its pixel ranges and, where its four corners are shaded, (e, s̄²).
-            #[allow(clippy::type_complexity)]
-            let mut cells: Vec<((usize, usize), (usize, usize), Option<(f64, f64)>)> = Vec::new();
+            let mut cells: Vec<Cell> = Vec::new();
             for cy in ys.windows(2) {
                 for cx in xs.windows(2) {
                     let idx = [
@@ -279,9 +293,16 @@ impl SamplingPlan {
                             .map(|p| sd_at(*p).powi(2) / f64::from(self.rays[*p]))
                             .sum::<f64>()
                             / 4.0;
-                        (spread - noise, noise)
+                        Spread {
+                            excess: spread - noise,
+                            noise,
+                        }
                     });
-                    cells.push(((cx[0], cx[1]), (cy[0], cy[1]), stat));
+                    cells.push(Cell {
+                        xs: (cx[0], cx[1]),
+                        ys: (cy[0], cy[1]),
+                        spread: stat,
+                    });
                 }
             }
             let fill = |shaded: &mut [bool], (x0, x1): (usize, usize), (y0, y1): (usize, usize)| {
@@ -292,8 +313,15 @@ impl SamplingPlan {
                 }
             };
             // Rule 1, local.
-            for &(xr, yr, stat) in &cells {
-                let Some((e, noise)) = stat else { continue };
+            for &Cell {
+                xs: xr,
+                ys: yr,
+                spread,
+            } in &cells
+            {
+                let Some(Spread { excess: e, noise }) = spread else {
+                    continue;
+                };
                 let sigma = [(xr.0, yr.0), (xr.1, yr.0), (xr.0, yr.1), (xr.1, yr.1)]
                     .iter()
                     .map(|(x, y)| sd_at(y * w + x))
@@ -313,8 +341,8 @@ impl SamplingPlan {
                     let mut es = Vec::new();
                     for jj in j.saturating_sub(POOL_ROWS)..(j + POOL_ROWS + 1).min(ch) {
                         for ii in 0..cw {
-                            if let Some((e, _)) = cells[jj * cw + ii].2 {
-                                es.push(e);
+                            if let Some(spread) = cells[jj * cw + ii].spread {
+                                es.push(spread.excess);
                             }
                         }
                     }
@@ -346,7 +374,11 @@ impl SamplingPlan {
             };
             let open = |shaded: &[bool], c: usize, lambda: f64, free: bool| -> (f64, Vec<usize>) {
                 let rho = if free { realised[c].1 } else { realised[c].0 };
-                let ((x0, x1), (y0, y1), _) = cells[c];
+                let Cell {
+                    xs: (x0, x1),
+                    ys: (y0, y1),
+                    ..
+                } = cells[c];
                 let mut loss = 0.0;
                 let mut pixels = Vec::new();
                 for y in y0..=y1 {
