@@ -16,8 +16,9 @@ use crate::{LinearImage, RenderError, Renderer, Scene, ViewTarget};
 use lodestone_core::eval::adaptive_window::{
     WindowOptions, WindowReconstruction, WindowSample, reconstruct,
 };
-use lodestone_core::eval::sampling_plan::{SamplingPlan, water_fill};
+use lodestone_core::eval::sampling_plan::SamplingPlan;
 use lodestone_core::eval::truth_prediction::TruthPrediction;
+use lodestone_core::math::water_fill::water_fill;
 
 /// The uniform share of an adaptive plan's allocation: rays go in proportion to
 /// `σ̂ + DEFENSIVE·mean(σ̂)` (a defensive mixture, Hesterberg 1995), so no pixel gets less than

@@ -14,3 +14,4 @@ pub mod rounding;
 pub mod sh;
 pub mod special;
 pub mod special_f32;
+pub mod water_fill;
