@@ -291,11 +291,10 @@ impl SamplingPlan {
                     fill(&mut shaded, xr, yr);
                 }
             }
-            // Rule 2, pooled: the realisation's variance per cell from its neighbourhood.
-            // (lower bound, point estimate) per cell.
-            let realised: Vec<(f64, f64)> = (0..cells.len())
-                .map(|c| {
-                    let j = c / cw.max(1);
+            // Rule 2, pooled: the realisation's variance, (lower bound, point estimate), once per
+            // row of cells from the rows around it (every cell of a row shares it).
+            let pooled: Vec<(f64, f64)> = (0..ch)
+                .map(|j| {
                     let mut es = Vec::new();
                     for jj in j.saturating_sub(POOL_ROWS)..(j + POOL_ROWS + 1).min(ch) {
                         for ii in 0..cw {
@@ -319,6 +318,9 @@ impl SamplingPlan {
                     let point = if total > 2.0 * se { mean } else { 0.0 };
                     (lower, point)
                 })
+                .collect();
+            let realised: Vec<(f64, f64)> = (0..cells.len())
+                .map(|c| pooled.get(c / cw.max(1)).copied().unwrap_or((0.0, 0.0)))
                 .collect();
             // What interpolating a cell's unshaded pixels loses: the realisation's bias and the
             // corners' noise carried through the weights, the corners at the rays the final
