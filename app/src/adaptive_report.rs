@@ -314,7 +314,7 @@ pub fn markdown(configs: &[(String, &[UniformPoint], &[AdaptiveResult])]) -> Str
     }
     let _ = writeln!(
         s,
-        "## Adaptive ground truth (#18 §1)\n\nRMSE against the true image (the reference's noise \
+        "## Adaptive ground truth\n\nRMSE against the true image (the reference's noise \
          accounted per pixel), rays a pixel on average, the uniform rays a pixel that reach the same \
          error, and the gains in rays and in time (the model's CPU prediction included).\n"
     );

@@ -9,7 +9,7 @@ use crate::preset_io::Resolved;
 use crate::render_cmd::{View, frame_ms_interleaved, renderer};
 use anyhow::Result;
 use lodestone_core::material::features::FeatureSet;
-use lodestone_render::renderer::material_data_for;
+use lodestone_render::material_data::material_data_for;
 use lodestone_render::specialize::{ShaderSize, view_source_for};
 use lodestone_render::{GpuMaterial, ViewMode, ViewTarget};
 use serde_json::{Value, json};

@@ -116,8 +116,8 @@ fn check_output(out: &Path, folder: bool) -> Result<(), UsageError> {
 fn exit_code(e: &anyhow::Error) -> u8 {
     let too_large = |c: &(dyn std::error::Error + 'static)| {
         matches!(
-            c.downcast_ref::<lodestone_render::renderer::RenderError>(),
-            Some(lodestone_render::renderer::RenderError::TooLarge { .. })
+            c.downcast_ref::<lodestone_render::RenderError>(),
+            Some(lodestone_render::RenderError::TooLarge { .. })
         )
     };
     if e.chain().any(|c| {
@@ -433,7 +433,7 @@ fn run(cli: Cli) -> Result<()> {
                 };
                 let table = object_cmd::run(material, &sweep)?;
                 let section = format!(
-                    "\n## Whole object (#19): voxel views against ground truth\n\n\
+                    "\n## Whole object: voxel views against ground truth\n\n\
                      `lodestone object` on the unit sphere, octree depth {object_depth}, at the \
                      report's size (strips in `objects/`).\n\n{table}\n"
                 );

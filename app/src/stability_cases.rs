@@ -7,11 +7,11 @@
 //! floor, `|got − ref| / max(|ref|, floor)`, so values that underflow (erfc(30) ≈ 2e-393) compare as 0.
 
 use crate::stability_materials::{angles, step_map, vertical_curve};
-use lodestone_core::material::preconvolved::TableSpec;
-use lodestone_core::material::transfer::TransferFunction;
+use lodestone_core::math::preconvolved::TableSpec;
 use lodestone_core::math::quadrature::integrate;
 use lodestone_core::math::{special, special_f32};
 use lodestone_core::microfacet::effective_height::{EffectiveHeightTable, exact_moments};
+use lodestone_core::microfacet::transfer::TransferFunction;
 use lodestone_core::scene::direction::direction;
 use serde::Serialize;
 use std::f64::consts::{FRAC_PI_2, PI};

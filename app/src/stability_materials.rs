@@ -13,9 +13,9 @@ use lodestone_core::material::color_terms::{ColorTerms, CombineMode, ConstantTer
 use lodestone_core::material::colormap::{ColorStop, Gradient, Interpolation};
 use lodestone_core::material::environment::{Environment, EnvironmentSource, Lighting, Sky};
 use lodestone_core::material::slope_color::SlopeColor;
-use lodestone_core::material::transfer::{Curve, TransferFunction};
 use lodestone_core::material::{ColorModel, ColorSource, Heights, Material, Slopes};
 use lodestone_core::microfacet::slope_masking::SlopeMasking;
+use lodestone_core::microfacet::transfer::{Curve, TransferFunction};
 use lodestone_core::scene::direction::direction;
 use std::f64::consts::FRAC_PI_2;
 use std::sync::Arc;
@@ -457,7 +457,7 @@ pub fn vertical_curve() -> Curve {
             [0.5, 1.0],
             [2.0, 1.0],
         ],
-        interpolation: lodestone_core::material::transfer::CurveInterpolation::Linear,
+        interpolation: lodestone_core::microfacet::transfer::CurveInterpolation::Linear,
     }
 }
 

@@ -383,7 +383,7 @@ fn report_on_the_cylinder() {
     assert_eq!(rep["object"], "cylinder of radius 1");
     // The whole object (#19) as a section of report.md, its strip beside it.
     let md = std::fs::read_to_string(dir.join("report.md")).unwrap();
-    assert!(md.contains("## Whole object (#19)"), "{md}");
+    assert!(md.contains("## Whole object: voxel views"), "{md}");
     assert!(md.contains("| 6 |"), "{md}");
     assert!(dir.join("objects").join("object-d6.png").is_file());
     for c in rep["configs"].as_array().unwrap() {

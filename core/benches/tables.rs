@@ -3,9 +3,9 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use lodestone_core::material::colormap::Gradient;
-use lodestone_core::material::preconvolved::TableSpec;
-use lodestone_core::material::transfer::{Curve, TransferFunction};
+use lodestone_core::math::preconvolved::TableSpec;
 use lodestone_core::microfacet::effective_height::EffectiveHeightTable;
+use lodestone_core::microfacet::transfer::{Curve, TransferFunction};
 use std::hint::black_box;
 
 fn tables(c: &mut Criterion) {

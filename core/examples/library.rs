@@ -5,9 +5,9 @@
 
 use lodestone_core::driver::noise::NoiseParams;
 use lodestone_core::material::colormap::{ColorStop, Gradient, Interpolation};
-use lodestone_core::material::transfer::{Curve, TransferFunction};
 use lodestone_core::material::{ColorModel, ColorSource, Driver, Heights, Material, Slopes};
 use lodestone_core::microfacet::brdf::BaseBrdf;
+use lodestone_core::microfacet::transfer::{Curve, TransferFunction};
 
 fn preset(name: &str) -> Option<(&'static str, Material)> {
     let base = Material::default();

@@ -13,8 +13,8 @@
 use glam::{DVec2, DVec3};
 use lodestone_core::driver::field::DriverField;
 use lodestone_core::material::Material;
-use lodestone_core::material::transfer::TransferFunction;
 use lodestone_core::math::random::splitmix;
+use lodestone_core::microfacet::transfer::TransferFunction;
 use lodestone_core::scene::direction::direction;
 use lodestone_core::scene::march::{March, march_heightfield};
 use lodestone_core::scene::surface::Surface;

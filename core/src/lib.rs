@@ -22,8 +22,11 @@
 //! * [HN12] Heitz, Neyret. *Representing Appearance and Pre-filtering Subpixel Data in Sparse Voxel Octrees.* HPG 2012.
 //! * [HNPN14] Heitz, Nowrouzezahrai, Poulin, Neyret. *Filtering Non-Linear Transfer Functions on Surfaces.* TVCG 2014.
 
+pub mod adaptive;
 pub mod driver;
 pub mod eval;
+#[doc(hidden)]
+pub mod fixtures;
 pub mod material;
 pub mod math;
 pub mod microfacet;

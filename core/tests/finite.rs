@@ -4,8 +4,8 @@
 use glam::{DVec2, DVec3};
 use lodestone_core::driver::footprint::Footprint;
 use lodestone_core::eval::{Evaluator, FootprintQuery};
-use lodestone_core::material::preconvolved::TableSpec;
 use lodestone_core::material::{Material, Slopes};
+use lodestone_core::math::preconvolved::TableSpec;
 use lodestone_core::math::{special, special_f32};
 use lodestone_core::microfacet::attribute::mean_attribute_shape;
 use lodestone_core::microfacet::effective_height::{HeightFilter, height_moments};

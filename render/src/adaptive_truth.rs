@@ -13,11 +13,11 @@
 
 use crate::truth_noise::{SampleMoments, TruthEstimate};
 use crate::{LinearImage, RenderError, Renderer, Scene, ViewTarget};
-use lodestone_core::eval::adaptive_window::{
+use lodestone_core::adaptive::sampling_plan::SamplingPlan;
+use lodestone_core::adaptive::truth_prediction::TruthPrediction;
+use lodestone_core::adaptive::windows::{
     WindowOptions, WindowReconstruction, WindowSample, reconstruct,
 };
-use lodestone_core::eval::sampling_plan::SamplingPlan;
-use lodestone_core::eval::truth_prediction::TruthPrediction;
 use lodestone_core::math::water_fill::water_fill;
 
 /// The uniform share of an adaptive plan's allocation: rays go in proportion to
@@ -262,12 +262,12 @@ pub fn ray_costs(work: &[u32], rays: &[u32]) -> Vec<f64> {
 
 /// A ground truth (`image`, its squared sums `moments`) reconstructed over windows chosen per pixel
 /// by the intersection of confidence intervals
-/// ([`lodestone_core::eval::adaptive_window`], [BSSBH13 Sec. 3]): each pixel's value pools the rays
+/// ([`lodestone_core::adaptive::windows`], [BSSBH13 Sec. 3]): each pixel's value pools the rays
 /// of the least noisy window around it whose mean stays within its noise. One ray's variance per pixel
 /// is its measured sample variance pooled with the prediction `predicted` ([`pixel_deviations`];
 /// a `predicted` of the wrong size counts as 0, which shrinks the measured variance and so the
 /// windows). `guide`, the predicted luminance per pixel, refuses windows it predicts biased
-/// ([`lodestone_core::eval::adaptive_window::reconstruct`]). Returns the image (weight 1) and the
+/// ([`lodestone_core::adaptive::windows::reconstruct`]). Returns the image (weight 1) and the
 /// windows.
 pub fn reconstruct_truth(
     image: &LinearImage,

@@ -1,6 +1,6 @@
 //! The error view: per-pixel |mode − ground truth| as a heat map with a legend bar, plus RMSE and max.
 
-use crate::renderer::LinearImage;
+use crate::image::LinearImage;
 use lodestone_core::material::colormap::Gradient;
 
 /// Error statistics of one image against a reference (linear RGB).

@@ -20,11 +20,11 @@
 //! same arguments.
 
 use crate::gpu_types::{GpuStruct, MaterialParams};
-use crate::renderer::material_data;
+use crate::material_data::material_data;
 use crate::shaders;
 use lodestone_core::eval::Evaluator;
 use lodestone_core::material::features::FeatureSet;
-use lodestone_core::material::preconvolved::PreconvolvedTable;
+use lodestone_core::math::preconvolved::PreconvolvedTable;
 use lodestone_core::microfacet::effective_height::EffectiveHeightTable;
 use serde_json::json;
 

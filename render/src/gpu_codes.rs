@@ -7,9 +7,10 @@
 use crate::gpu_types::{GpuStruct, MaterialParams};
 use lodestone_core::driver::conditional_slopes;
 use lodestone_core::driver::histogram::G_END;
+use lodestone_core::eval::interception;
 use lodestone_core::eval::lod_surface::LOD_SETTLE;
-use lodestone_core::eval::{
-    interception, slope_masking_table, transfer_masking_table, transfer_moments,
+use lodestone_core::eval::masking::{
+    slope_masking_table, transfer_masking_table, transfer_moments,
 };
 use lodestone_core::math::gaussian_weight;
 use lodestone_core::microfacet::effective_height::{
@@ -190,7 +191,7 @@ pub fn wgsl_prelude() -> &'static str {
                 "TRANSFER_MOMENT_ENTRY",
                 transfer_masking_table::MOMENT_ENTRY as u32,
             ),
-            ("DATA_ROW", crate::renderer::DATA_ROW),
+            ("DATA_ROW", DATA_ROW),
             ("INTERCEPTION_MAX_STEPS", interception::MAX_STEPS as u32),
         ];
         for (name, v) in sets.into_iter().flatten().chain(counts) {
@@ -276,3 +277,8 @@ mod tests {
         }
     }
 }
+
+/// Words of the material's data per row of its texture (a power of two; `DATA_ROW` in WGSL).
+pub const DATA_ROW: u32 = 4096;
+
+const _: () = assert!(DATA_ROW.is_power_of_two());

@@ -292,7 +292,7 @@ gpu_struct! {
         ht_m_max: f32 => "f32",
         /// Table H's largest σ.
         ht_sigma_max: f32 => "f32",
-        /// Offset of the transfer table's slope pyramids (core's `material::table_slope::TableSlope`).
+        /// Offset of the transfer table's slope pyramids (core's `math::table_slope::TableSlope`).
         ts_offset: u32 => "u32",
         /// Column intervals per pyramid row, rounded up to a power of two (`TableSlope::p`).
         ts_p: u32 => "u32",
@@ -315,12 +315,12 @@ gpu_struct! {
         /// Number of fitted lobes (0 for the analytic BRDF).
         lobe_count: u32 => "u32",
         /// Offset of the slope-conditioned masking table (core's
-        /// `eval::slope_masking_table::SlopeMaskingTable`: r0, the level step, then the profiles).
+        /// `eval::masking::slope_masking_table::SlopeMaskingTable`: r0, the level step, then the profiles).
         cm_offset: u32 => "u32",
         /// 1 when the filtered view conditions masking on the slope (the table is present).
         cm_on: u32 => "u32",
         /// Offset of the transfer curve's masking table conditioned on the driver's value and
-        /// slope (core's `eval::transfer_masking_table::TransferMaskingTable`: σ_f, the gradient
+        /// slope (core's `eval::masking::transfer_masking_table::TransferMaskingTable`: σ_f, the gradient
         /// covariance xx, xy, yy, then the entries).
         tm_offset: u32 => "u32",
         /// 1 when the transfer mixture's bins take that table (`tm_offset` is set).

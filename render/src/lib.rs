@@ -8,16 +8,28 @@
 
 pub mod adaptive_truth;
 pub mod compute;
+pub mod error;
 pub mod error_map;
 pub mod export;
 pub mod gpu;
 pub mod gpu_codes;
+pub mod gpu_material;
 pub mod gpu_types;
+pub mod image;
+pub mod material_data;
 pub mod object;
+pub mod pipelines;
 pub mod renderer;
 pub mod shaders;
 pub mod specialize;
 pub mod truth_noise;
+pub mod view;
+pub mod view_target;
 
+pub use error::RenderError;
 pub use gpu::{GpuContext, GpuError};
-pub use renderer::{GpuMaterial, LinearImage, RenderError, Renderer, Scene, ViewMode, ViewTarget};
+pub use gpu_material::GpuMaterial;
+pub use image::LinearImage;
+pub use renderer::Renderer;
+pub use view::{Scene, ViewMode};
+pub use view_target::ViewTarget;

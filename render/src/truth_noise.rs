@@ -32,7 +32,7 @@
 //! The estimates err on the safe side: fewer blocks flagged significant, an excess error a little
 //! low (the same amount is removed from every view, so their ranking does not depend on it).
 
-use crate::renderer::LinearImage;
+use crate::image::LinearImage;
 use lodestone_core::material::colormap::Gradient;
 
 /// Rec. 709 luminance weights (linear RGB), core's. `view.wgsl` accumulates `Y²` with the same weights.

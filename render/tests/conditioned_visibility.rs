@@ -1,10 +1,10 @@
 //! The WGSL mirrors of #17's conditioned visibility (`math/gaussian_weight.wgsl`,
-//! `eval/transfer_masking_table.wgsl`) against lodestone-core's f64 on the GPU adapter: the
+//! `eval/masking/transfer_masking_table.wgsl`) against lodestone-core's f64 on the GPU adapter: the
 //! Gaussian weights' products, powers, expectations and tilts, and the table's rays and visibility
 //! weights over views, lights and values.
 
 use glam::{DMat2, DVec2};
-use lodestone_core::eval::transfer_masking_table::TransferMaskingTable;
+use lodestone_core::eval::masking::transfer_masking_table::TransferMaskingTable;
 use lodestone_core::material::Material;
 use lodestone_core::material::features::FeatureSet;
 use lodestone_core::math::gaussian_weight::GaussianWeight;
@@ -24,8 +24,8 @@ fn library(extra: &str) -> String {
         include_str!("../src/shaders/microfacet/masking_shadowing.wgsl"),
         include_str!("../src/shaders/driver/footprint.wgsl"),
         include_str!("../src/shaders/microfacet/slope_masking.wgsl"),
-        include_str!("../src/shaders/eval/slope_masking_table.wgsl"),
-        include_str!("../src/shaders/eval/transfer_masking_table.wgsl"),
+        include_str!("../src/shaders/eval/masking/slope_masking_table.wgsl"),
+        include_str!("../src/shaders/eval/masking/transfer_masking_table.wgsl"),
     ];
     let data = "var<private> params: Params;\nconst PI: f32 = 3.14159265;\nconst SQRT_2: f32 = 1.4142135;\nfn datum(i: u32) -> f32 { return inputs[i]; }\n";
     let mut parts = vec![gpu_codes::wgsl_prelude(), shaders::SPECIAL, data];
@@ -173,7 +173,7 @@ fn wgsl_gaussian_weights_match_core_on_the_adapter() {
 #[test]
 fn wgsl_transfer_rays_match_core_on_the_adapter() {
     use lodestone_core::driver::footprint::FilteredDriver;
-    use lodestone_core::eval::transfer_masking_table::TransferRays;
+    use lodestone_core::eval::masking::transfer_masking_table::TransferRays;
     use lodestone_core::microfacet::masking_shadowing::Correlation;
     use lodestone_core::microfacet::slopes::SlopeCov;
     use lodestone_core::scene::direction::direction;

@@ -277,7 +277,7 @@ fn image_driver_bundle_describes_the_pyramid() {
     let data: &[f32] = bytemuck::cast_slice(file(&files, "data.bin"));
     let table = d["level_table_offset_floats"].as_u64().unwrap() as usize;
     for (l, level) in img.levels.iter().enumerate() {
-        let n = lodestone_render::renderer::IMAGE_LEVEL_SLOTS;
+        let n = lodestone_render::material_data::IMAGE_LEVEL_SLOTS;
         let slot = &data[table + n * l..table + n * (l + 1)];
         assert_eq!(f64::from(slot[5]), level.lipschitz.x);
         assert_eq!(slot[2].to_bits() as usize, level.width);

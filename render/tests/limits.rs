@@ -1,7 +1,8 @@
 //! Hostile sizes (issue #16): a view target or material data beyond what the adapter can bind is a
 //! clear error before anything is created, never a wgpu validation panic.
 
-use lodestone_render::renderer::{RenderError, ViewTarget, max_pixels};
+use lodestone_render::view_target::max_pixels;
+use lodestone_render::{RenderError, ViewTarget};
 
 #[test]
 fn targets_beyond_the_adapter_limit_are_refused_and_smaller_ones_render() {

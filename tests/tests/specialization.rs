@@ -13,7 +13,7 @@ use lodestone_core::material::features::{Feature, FeatureSet};
 use lodestone_core::scene::camera::Camera;
 use lodestone_core::scene::direction::direction;
 use lodestone_core::scene::shape::Shape;
-use lodestone_render::renderer::material_data_for;
+use lodestone_render::material_data::material_data_for;
 use lodestone_render::specialize::{ShaderSize, view_source_for};
 use lodestone_render::{GpuMaterial, LinearImage, Scene, ViewMode};
 use lodestone_tests::{prepare, presets};
@@ -303,7 +303,7 @@ fn flat_colour_mapped_noise_compiles_a_fraction_of_the_shader_and_uploads_no_vis
     let prepared = prepare("presets/colormapped-noise.ron", &m);
     let special = material_data_for(&prepared, [0.0; 2], set);
     let all = material_data_for(&prepared, [0.0; 2], FeatureSet::all());
-    let names = |d: &lodestone_render::renderer::MaterialData| -> Vec<&str> {
+    let names = |d: &lodestone_render::material_data::MaterialData| -> Vec<&str> {
         d.segments.iter().map(|(n, _)| *n).collect()
     };
     assert!(!names(&special).contains(&"visible-height table D_h"));

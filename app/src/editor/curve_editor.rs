@@ -4,7 +4,7 @@
 
 use egui::{Color32, Pos2, Rect, Role, Sense, Stroke, Ui, Vec2, WidgetInfo};
 use lodestone_core::driver::image::ImageDriver;
-use lodestone_core::material::transfer::{Curve, CurveInterpolation, TransferFunction};
+use lodestone_core::microfacet::transfer::{Curve, CurveInterpolation, TransferFunction};
 use std::sync::Arc;
 
 /// Persistent UI state (the selected point).

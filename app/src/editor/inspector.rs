@@ -13,7 +13,6 @@ use lodestone_core::material::environment::{Environment, EnvironmentSource, Ligh
 use lodestone_core::material::features::{Feature, FeatureSet};
 use lodestone_core::material::merl_fit::MerlFit;
 use lodestone_core::material::slope_color::SlopeColor;
-use lodestone_core::material::transfer::{SurfaceShape, TransferFunction};
 use lodestone_core::material::{ColorModel, ColorSource, Driver, Filtering, Material};
 use lodestone_core::microfacet::brdf::BaseBrdf;
 use lodestone_core::microfacet::effective_height::HeightFilter;
@@ -21,6 +20,7 @@ use lodestone_core::microfacet::height_mixture::TransferSlopes;
 use lodestone_core::microfacet::masking_shadowing::Correlation;
 use lodestone_core::microfacet::slope_density::NoiseSlopes;
 use lodestone_core::microfacet::slope_masking::SlopeMasking;
+use lodestone_core::microfacet::transfer::{SurfaceShape, TransferFunction};
 use std::sync::Arc;
 
 /// UI state of the inspector.
@@ -842,7 +842,7 @@ fn filtering(ui: &mut Ui, f: &mut Filtering) -> bool {
             ui.selectable_value(&mut sm, SlopeMasking::Conditioned, "Conditioned on slope");
         })
         .response
-        .on_hover_text("Masking of the visible (height, slope) pairs: Smith's, where a facet's visibility depends on its height alone [HN12 Eqs. 4–6], or conditioned on the facet's height and slope along the view jointly (default; Smith's crossing rate with the surface conditioned on the start's height and slope through the noise's autocovariance; Rice, Smith 1967): facets facing the eye are seen more, those leaning to the silhouette less, high ones at every slope; each slope then sees its own heights, so colour and shading are summed together. Noise drivers (images keep Smith's); snake-skin at 75°: from −9% to +0.6% against the ray-traced truth (#17, docs/design.md). A table of about a second per noise");
+        .on_hover_text("Masking of the visible (height, slope) pairs: Smith's, where a facet's visibility depends on its height alone [HN12 Eqs. 4–6], or conditioned on the facet's height and slope along the view jointly (default; Smith's crossing rate with the surface conditioned on the start's height and slope through the noise's autocovariance; Rice, Smith 1967): facets facing the eye are seen more, those leaning to the silhouette less, high ones at every slope; each slope then sees its own heights, so colour and shading are summed together. Noise drivers (images keep Smith's); snake-skin at 75°: from −9% to +0.6% against the ray-traced truth (docs/design/slope-masking.md). A table of about a second per noise");
     if sm != f.slope_masking {
         f.slope_masking = sm;
         changed = true;

@@ -4,8 +4,8 @@
 
 use super::view_state::TruthDisplay;
 use super::worker::Frame;
-use lodestone_core::eval::adaptive_window::{WindowOptions, WindowReconstruction};
-use lodestone_core::eval::image_bandwidth::NYQUIST;
+use lodestone_core::adaptive::image_bandwidth::NYQUIST;
+use lodestone_core::adaptive::windows::{WindowOptions, WindowReconstruction};
 use lodestone_render::LinearImage;
 use lodestone_render::adaptive_truth::reconstruct_truth;
 use lodestone_render::error_map::heat_gradient;

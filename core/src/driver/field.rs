@@ -3,11 +3,9 @@
 //! moments). Everything downstream — the explicit surface, the level-of-detail surface, the filtered
 //! statistics — asks this type, so both kinds go through the same code paths.
 
-use crate::driver::DriverError;
 use crate::driver::footprint::{FilteredDriver, Footprint};
 use crate::driver::image::{ImageDriver, lod_for_std};
 use crate::driver::noise::SumOfSines;
-use crate::material::{Driver, Material};
 use crate::microfacet::slopes::SlopeCov;
 use glam::DVec2;
 use std::f64::consts::TAU;
@@ -40,23 +38,17 @@ pub enum DriverField {
 }
 
 impl DriverField {
-    /// The driver of `material`; an image driver needs its decoded `image` (the application loads
-    /// it relative to the preset), otherwise [`DriverError::ImageDriver`].
-    pub fn new(material: &Material, image: Option<Arc<ImageDriver>>) -> Result<Self, DriverError> {
-        match (&material.driver, image) {
-            (Driver::Noise(_), _) => Ok(Self::Noise(
-                material.noise().expect("a noise driver has noise"),
-            )),
-            (Driver::Image { size, .. }, Some(image)) => Ok(Self::Image(TiledImage {
-                image,
-                size: if size.is_finite() && *size > 0.0 {
-                    *size
-                } else {
-                    1.0
-                },
-            })),
-            (Driver::Image { .. }, None) => Err(DriverError::ImageDriver),
-        }
+    /// An image driver tiled every `size` world units (a `size` that is not finite and positive
+    /// reads as 1).
+    pub fn tiled(image: Arc<ImageDriver>, size: f64) -> Self {
+        Self::Image(TiledImage {
+            image,
+            size: if size.is_finite() && size > 0.0 {
+                size
+            } else {
+                1.0
+            },
+        })
     }
 
     /// The image, for an image driver.
@@ -224,6 +216,7 @@ impl DriverField {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::driver::DriverError;
     use crate::driver::noise::Wave;
     use crate::eval::{Evaluator, FootprintQuery};
     use crate::material::Driver;
@@ -335,7 +328,7 @@ pub(crate) mod tests {
     fn image_driven_material_filtered_matches_ground_truth() {
         let tile = 2.0;
         let noise = tiling_waves(tile);
-        let mut m = crate::eval::test_materials::gaussian_material();
+        let mut m = crate::fixtures::gaussian_material();
         m.driver = Driver::Image {
             path: "test.png".into(),
             size: tile,

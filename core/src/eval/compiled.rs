@@ -5,12 +5,12 @@
 use crate::driver::histogram::{DriverHistogram, MU_RANGE, SIGMA_G_MAX};
 use crate::eval::query::FootprintStats;
 use crate::material::colormap::Gradient;
-use crate::material::preconvolved::{PreconvolvedTable, TableSpec};
-use crate::material::table_slope::TableSlope;
-use crate::material::transfer::{TransferFunction, TransferMoments};
 use crate::material::{ColorModel, ColorSource};
+use crate::math::preconvolved::{PreconvolvedTable, TableSpec};
 use crate::math::special::erf;
+use crate::math::table_slope::TableSlope;
 use crate::microfacet::attribute::{attribute_shape, mean_attribute_shape};
+use crate::microfacet::transfer::{TransferFunction, TransferMoments};
 
 /// The colour model, compiled.
 #[derive(Clone, Debug, PartialEq)]

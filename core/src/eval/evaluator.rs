@@ -9,15 +9,15 @@ use crate::driver::histogram::DriverHistogram;
 use crate::driver::image::ImageDriver;
 use crate::eval::compiled::{CompiledColor, CompiledTransfer};
 use crate::eval::interception::Interception;
-use crate::eval::slope_masking_table::SlopeMaskingTable;
-use crate::eval::transfer_masking_table::TransferMaskingTable;
+use crate::eval::masking::slope_masking_table::SlopeMaskingTable;
+use crate::eval::masking::transfer_masking_table::TransferMaskingTable;
 use crate::material::Material;
 use crate::material::environment::EquirectMap;
 use crate::material::measured::{ChannelWeights, MeasuredBrdf};
 use crate::material::slope_color::CompiledSlopeColor;
-use crate::material::transfer::TransferFunction;
 use crate::math::sh::Sh9;
 use crate::microfacet::slope_masking::SlopeMasking;
+use crate::microfacet::transfer::TransferFunction;
 use crate::scene::surface::Surface;
 use std::sync::Arc;
 
@@ -48,10 +48,10 @@ pub struct Evaluator {
     /// loaded yet).
     pub measured: Option<Arc<MeasuredBrdf>>,
     /// The noise's table of slope-conditioned masking, when the material asks for it
-    /// (`filtering.slope_masking`, [`crate::eval::slope_masking_table`]).
+    /// (`filtering.slope_masking`, [`crate::eval::masking::slope_masking_table`]).
     pub slope_masking: Option<Arc<SlopeMaskingTable>>,
     /// The transfer mixture's masking conditioned on the driver's value and slope
-    /// ([`crate::eval::transfer_masking_table`]): built for a noise driver under a transfer curve
+    /// ([`crate::eval::masking::transfer_masking_table`]): built for a noise driver under a transfer curve
     /// when `filtering.slope_masking` is conditioned (Smith's bins otherwise).
     pub transfer_masking: Option<Arc<TransferMaskingTable>>,
     /// Whether the analytic views' camera rays can be stopped by the unresolved relief on a crest
@@ -227,8 +227,8 @@ mod reuse_tests {
     use super::*;
     use crate::material::ColorModel;
     use crate::material::colormap::Gradient;
-    use crate::material::transfer::Curve;
-    use crate::material::transfer::TransferFunction;
+    use crate::microfacet::transfer::Curve;
+    use crate::microfacet::transfer::TransferFunction;
 
     fn tables(p: &Evaluator) -> (Vec<[f32; 4]>, Vec<[f32; 4]>) {
         (

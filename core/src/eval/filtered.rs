@@ -10,15 +10,15 @@
 //! over the driver's value instead of one Gaussian ([`crate::eval::mixture_bins`]).
 
 use crate::driver::field::DriverField;
-use crate::eval::slope_weights::joint_inputs;
+use crate::eval::masking::slope_weights::joint_inputs;
 use crate::eval::{Evaluator, FootprintQuery};
 use crate::material::color_terms::Affine;
-use crate::material::transfer::TransferFunction;
 use crate::microfacet::effective_height::{HeightMoments, height_moments};
 use crate::microfacet::masking_shadowing::G2;
 use crate::microfacet::slope_density::{NoiseSlopes, sinusoid_density_ratio};
 use crate::microfacet::slope_masking::SLOPE_NODES;
 use crate::microfacet::slopes::{normal_of, slope_of};
+use crate::microfacet::transfer::TransferFunction;
 use crate::scene::direction::basis;
 use glam::{DMat3, DVec2, DVec3};
 
@@ -37,7 +37,7 @@ impl Evaluator {
 
     /// [`Evaluator::filtered`] with the sun's visibility and the tangent frame, as
     /// [`Evaluator::naive`]'s.
-    pub(super) fn filtered_lit(
+    pub(crate) fn filtered_lit(
         &self,
         cfg: &FootprintQuery,
         sun_visible: f64,
@@ -151,7 +151,7 @@ impl Evaluator {
     /// the ray still meets (image drivers at the horizon): the view then grazes the mean plane,
     /// kept just above its horizon so that the result is continuous across the tilt instead of
     /// black ([`above_horizon`]).
-    pub(super) fn footprint_frame(
+    pub(crate) fn footprint_frame(
         &self,
         cfg: &FootprintQuery,
     ) -> (crate::eval::query::FootprintStats, DVec3, DVec3) {

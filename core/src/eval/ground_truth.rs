@@ -236,7 +236,7 @@ impl Evaluator {
     /// frame, as ωo and ωi; `frame` to the world), `sees_light` the shadow ray (cast only when the
     /// directional light can contribute): the base BRDF under the directional light, plus the
     /// environment's irradiance at the micro-normal (unshadowed, see [`crate::material::environment`]).
-    pub(crate) fn shade_hit(
+    pub fn shade_hit(
         &self,
         f: f64,
         n: DVec3,
@@ -260,7 +260,7 @@ impl Evaluator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::eval::test_materials::preset;
+    use crate::fixtures::preset;
     use crate::scene::direction::direction;
 
     /// Batches merge into the estimate of all their rays: the mean is the rays' mean and the

@@ -179,7 +179,7 @@ impl Evaluator {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::eval::test_materials::preset;
+    use crate::fixtures::preset;
 
     /// Both limits are the views without it: far away nothing is resolved (u falls
     /// monotonically), close up nothing is unresolved; at middle zoom a grazing ray over the

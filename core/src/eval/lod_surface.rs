@@ -100,7 +100,7 @@ mod tests {
     use super::*;
     use crate::driver::image::ImageDriver;
     use crate::driver::test_images;
-    use crate::eval::test_materials::gaussian_material;
+    use crate::fixtures::gaussian_material;
     use crate::material::Driver;
     use crate::math::random::splitmix;
     use std::sync::Arc;

@@ -205,16 +205,16 @@ impl Evaluator {
 
 #[cfg(test)]
 mod tests {
-    use crate::eval::test_materials::gaussian_material;
     use crate::eval::{Evaluator, FootprintQuery};
-    use crate::material::transfer::{Curve, TransferFunction};
+    use crate::fixtures::gaussian_material;
     use crate::material::{ColorModel, ColorSource};
     use crate::microfacet::height_mixture::TransferSlopes;
+    use crate::microfacet::transfer::{Curve, TransferFunction};
     use crate::scene::direction::direction;
     use glam::DVec3;
 
     fn far(deg: f64, wi: DVec3) -> FootprintQuery {
-        crate::eval::test_materials::far_patch(direction(deg.to_radians(), 0.3), wi)
+        crate::fixtures::far_patch(direction(deg.to_radians(), 0.3), wi)
     }
 
     /// With the identity transfer the slopes do not depend on f: the mixture is one Gaussian and
@@ -329,8 +329,8 @@ mod tests {
 
 #[cfg(test)]
 mod binning {
-    use crate::eval::test_materials::preset;
     use crate::eval::{Evaluator, FootprintQuery};
+    use crate::fixtures::preset;
     use crate::microfacet::height_mixture::TransferSlopes;
     use crate::scene::direction::direction;
     use glam::DVec3;
@@ -430,7 +430,7 @@ mod image_tests {
         views: &[f64],
         azimuths: &[f64],
     ) -> Vec<(&'static str, bool, f64, f64, f64, f64, f64)> {
-        let base = crate::eval::test_materials::preset("cobblestones");
+        let base = crate::fixtures::preset("cobblestones");
         let mut gaussian = base.clone();
         gaussian.filtering.transfer_slopes = TransferSlopes::Gaussian;
         let mut rows = vec![];

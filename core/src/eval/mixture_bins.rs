@@ -26,7 +26,7 @@
 //! its [`BIN_SAMPLES`] sub-values, each with its own g′ and its own visibility (a riser and a tread
 //! in one bin are two slope scales, not their root mean square). Its conditioned G1 along ωo and
 //! joint masking–shadowing over the driver's slopes
-//! ([`crate::eval::transfer_masking_table::TransferRays::visibility_weights`]: each ray's from its
+//! ([`crate::eval::masking::transfer_masking_table::TransferRays::visibility_weights`]: each ray's from its
 //! 1-D moments in the table, their joint term in closed form) are Gaussian functions of the slopes: each
 //! reweights the slopes' Gaussian into another ([`GaussianWeight::tilted`]), which the bin shades
 //! as it shades any Gaussian of slopes (within 0.9% of summing shading and visibility node by
@@ -38,11 +38,10 @@
 //! Smith's bins have 5.06% and 14.46%; sponge 0.24% and 4.52% (Smith's 2.10% and 13.43%).
 
 use crate::driver::conditional_slopes::ImageSlopes;
+use crate::eval::masking::transfer_masking_table::TransferRays;
 use crate::eval::query::FootprintStats;
 use crate::eval::shading::{SlopeShading, specular_tint};
-use crate::eval::transfer_masking_table::TransferRays;
 use crate::eval::{Evaluator, FootprintQuery};
-use crate::material::transfer::TransferFunction;
 use crate::math::gaussian::cholesky;
 use crate::math::gaussian_weight::GaussianWeight;
 use crate::math::special::norm_quantile;
@@ -53,13 +52,14 @@ use crate::microfacet::height_mixture::{
 use crate::microfacet::masking_shadowing::G2;
 use crate::microfacet::slope_rule::SlopeRule;
 use crate::microfacet::slopes::SlopeCov;
+use crate::microfacet::transfer::TransferFunction;
 use crate::microfacet::visible_slopes::expected_positive_part;
 use glam::{DMat2, DMat3, DVec2, DVec3};
 
 use std::f64::consts::FRAC_1_PI;
 
 /// n of the polar rule (n² nodes) over a sub-value's slopes when its masking is conditioned on
-/// the driver's slope ([`crate::eval::transfer_masking_table`]), at least: the bins' own 4 × 4.
+/// the driver's slope ([`crate::eval::masking::transfer_masking_table`]), at least: the bins' own 4 × 4.
 /// On #17's grid 6 × 6 gave terraces 2.66% / 1.19%, sponge 0.00% / 4.39% and moss 0 / 0, and 4 × 4
 /// gives 2.69% / 1.32%, 0.24% / 4.52% and 0.05% / 0.21%, at 1868 instead of 2260 ms a frame on
 /// llvmpipe (terraces, 256 × 192; in one run with a Smith copy, 1872 against Smith's bins' 810).
@@ -137,7 +137,7 @@ impl Evaluator {
     /// and `wi` in the frame of the footprint's mean normal (for Λ), `cfg`'s in the macro frame
     /// (for the slope averages, which live in world slope space), `sun_visible` the shadow ray's
     /// verdict and `frame` the tangent frame, as [`Evaluator::filtered`] takes them.
-    pub(super) fn filtered_bins(
+    pub(crate) fn filtered_bins(
         &self,
         loc: &FootprintStats,
         cfg: &FootprintQuery,

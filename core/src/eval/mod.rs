@@ -29,48 +29,26 @@
 //! ([`pixel`], [`cylinder`]); the material compiled once into closed enums ([`compiled`]), the
 //! shading inputs every method shares ([`shading`]) and the footprint statistics ([`query`]).
 
-pub mod adaptive_window;
 pub mod compiled;
 pub mod cylinder;
 pub mod evaluator;
 pub mod filtered;
 pub mod ground_truth;
-pub mod image_bandwidth;
 pub mod interception;
 pub mod lod_surface;
+pub mod masking;
 pub mod mixture;
 pub mod mixture_bins;
 pub mod naive;
 pub mod pixel;
 pub mod query;
-pub mod ray_variance;
-pub mod sampling_plan;
 pub mod shading;
-pub mod slope_masking_table;
-pub mod slope_weights;
-pub mod transfer_masking_table;
-pub mod transfer_moments;
-pub mod truth_prediction;
 pub mod view_independent;
 
 #[cfg(test)]
-mod image_bandwidth_tests;
-#[cfg(test)]
-mod independent;
-#[cfg(test)]
-mod measurements;
-#[cfg(test)]
-mod slope_masking_measurements;
-#[cfg(test)]
-mod slope_weights_measurements;
-#[cfg(test)]
-pub(crate) mod test_materials;
+mod independent_tests;
 #[cfg(test)]
 mod tests;
-#[cfg(test)]
-mod transfer_masking_measurements;
-#[cfg(test)]
-mod transfer_masking_prototype;
 
 pub use compiled::{CompiledColor, CompiledTransfer};
 pub use evaluator::Evaluator;

@@ -4,7 +4,7 @@
 
 use crate::driver::footprint::{FilteredDriver, Footprint};
 use crate::eval::Evaluator;
-use crate::material::transfer::{SurfaceStats, TransferMoments, transformed_statistics};
+use crate::microfacet::transfer::{SurfaceStats, TransferMoments, transformed_statistics};
 use glam::{DVec2, DVec3};
 
 /// One view/light configuration over one footprint.
@@ -67,7 +67,7 @@ impl Evaluator {
 }
 
 /// 1 when the light is above the horizon of both the macro surface and the facet n, else 0.
-pub(super) fn lit(cfg: &FootprintQuery, n: DVec3) -> f64 {
+pub(crate) fn lit(cfg: &FootprintQuery, n: DVec3) -> f64 {
     if cfg.wi.z > 0.0 && n.dot(cfg.wi) > 0.0 {
         1.0
     } else {

@@ -55,12 +55,12 @@ impl SlopeShading {
 
 impl Evaluator {
     /// `C_s(n)` of the slope term (0 without one).
-    pub(super) fn slope_color_at(&self, n: DVec3) -> [f64; 3] {
+    pub(crate) fn slope_color_at(&self, n: DVec3) -> [f64; 3] {
         self.slope_color.as_ref().map_or([0.0; 3], |c| c.sample(n))
     }
 
     /// Environment irradiance at unit normal n (0 without an environment).
-    pub(super) fn environment_at(&self, n: DVec3) -> [f64; 3] {
+    pub(crate) fn environment_at(&self, n: DVec3) -> [f64; 3] {
         self.environment
             .as_ref()
             .map_or([0.0; 3], |e| e.irradiance(n))
@@ -68,7 +68,7 @@ impl Evaluator {
 
     /// [`SlopeShading`] of one facet of unit normal n (in the local tangent frame, where ωi is;
     /// `frame` takes it to the world, where the slope colour's direction and the environment are).
-    pub(super) fn point_shading(&self, n: DVec3, wi: DVec3, frame: &DMat3) -> SlopeShading {
+    pub(crate) fn point_shading(&self, n: DVec3, wi: DVec3, frame: &DMat3) -> SlopeShading {
         let cos = n.dot(wi).max(0.0);
         let nw = *frame * n;
         let cs = self.slope_color_at(nw);
@@ -85,7 +85,7 @@ impl Evaluator {
     /// (world slope space) on the material's weighted polar nodes ([`visible_slope_nodes`], [`crate::microfacet::visible_slopes::slope_rule`]):
     /// C_s and the environment are averaged *jointly* with the clamped cosine, so no independence of
     /// colour and shading is assumed ([HNPN14 Sec. 5.2] assumes it; the joint average costs the same).
-    pub(super) fn visible_shading(
+    pub(crate) fn visible_shading(
         &self,
         mean: DVec2,
         sigma: &SlopeCov,
@@ -104,7 +104,7 @@ impl Evaluator {
 
     /// The sums [`Evaluator::visible_shading`] divides: each input weighted by the node's
     /// visible projected area, and the sum of those weights, on the rule of order `points`.
-    pub(super) fn visible_shading_sums(
+    pub(crate) fn visible_shading_sums(
         &self,
         mean: DVec2,
         sigma: &SlopeCov,
@@ -128,7 +128,7 @@ impl Evaluator {
     /// `ρ_d/π·w_d⊙(sun·v·(A⊙E[cos] + K⊙E[C_s cos]) + A⊙E[E_env] + K⊙E[C_s⊙E_env]) + sun·v·spec⊙t`,
     /// with the diffuse weights w_d of [`Evaluator::channel_weights`] (1 for the analytic base
     /// BRDF, a measured BRDF's fitted kd) and the tint t of [`specular_tint`].
-    pub(super) fn radiance(
+    pub(crate) fn radiance(
         &self,
         sun_color: Affine,
         env_color: Affine,
@@ -152,7 +152,7 @@ impl Evaluator {
     /// The specular lobes per channel averaged over the visible slopes N(mean, Σ) (world slope
     /// space, [`filtered_specular`]): the base lobe, or a measured BRDF's fitted lobes
     /// `Σ_k filtered_specular(1, σ_k)·(w_k + v_k(1 − ωi·h)⁵)` ([`crate::material::merl_fit`]).
-    pub(super) fn specular_lobes(
+    pub(crate) fn specular_lobes(
         &self,
         mean: DVec2,
         sigma: &SlopeCov,
@@ -177,7 +177,7 @@ impl Evaluator {
 
     /// The specular lobes per channel of one facet of unit normal n (the base lobe's
     /// [`BaseBrdf::specular_with`], or a measured BRDF's fitted lobes there).
-    pub(super) fn facet_specular(&self, n: DVec3, wo: DVec3, wi: DVec3) -> [f64; 3] {
+    pub(crate) fn facet_specular(&self, n: DVec3, wo: DVec3, wi: DVec3) -> [f64; 3] {
         let Some(m) = &self.measured else {
             let b = &self.material.brdf;
             return [b.specular_with(n, wo, wi, SlopeCov::default()); 3];
@@ -209,7 +209,7 @@ impl Evaluator {
     /// the facet's colour, `sun·v·(A + K⊙C_s)⊙ρ(ωi, ωo)(n·ωi)⁺`, plus the environment on the fit's
     /// diffuse part ([`crate::material::measured`]). Ground truth's explicit facets and the naive
     /// view's filtered normal.
-    pub(super) fn facet_radiance(
+    pub(crate) fn facet_radiance(
         &self,
         color: Affine,
         n: DVec3,
@@ -241,7 +241,7 @@ impl Evaluator {
 /// Tint of the specular lobes: 1 for the analytic base BRDF, and for a measured BRDF (whose
 /// lobes the colour tints, [`crate::material::measured`]) the mean colour of the lit facets,
 /// `A + K⊙E[C_s cos]/E[cos]` (A where no facet is lit: the lobes are 0 there anyway).
-pub(super) fn specular_tint(w: &ChannelWeights, color: &Affine, s: &SlopeShading) -> [f64; 3] {
+pub(crate) fn specular_tint(w: &ChannelWeights, color: &Affine, s: &SlopeShading) -> [f64; 3] {
     [0, 1, 2].map(|c| {
         if !w.tint_specular {
             return 1.0;
@@ -272,7 +272,7 @@ pub const FACET_FRAME_MAX: f64 = 2.0;
 /// underestimates the convex `1/(n·h)⁴` by 15–50% at 45–75°). At grazing views the slope-space
 /// lobe is 2–3× too bright: a facet tilted toward the viewer sees ωo far less obliquely than the
 /// macro frame does. 1 for an untilted footprint (s̄ = 0, Σ = 0); at most [`FACET_FRAME_MAX`].
-pub(super) fn facet_frame_factor(
+pub(crate) fn facet_frame_factor(
     sigma_lobe: f64,
     mean: DVec2,
     sigma: &SlopeCov,

@@ -1,14 +1,14 @@
 //! The methods against each other and against the ground truth on a far footprint.
 
 use crate::driver::footprint::Footprint;
-use crate::eval::test_materials::gaussian_material;
 use crate::eval::{Evaluator, FootprintQuery};
+use crate::fixtures::gaussian_material;
 use crate::material::Slopes;
 use crate::scene::direction::direction;
 use glam::DVec3;
 
 fn far(wo: DVec3, wi: DVec3) -> FootprintQuery {
-    crate::eval::test_materials::far_patch(wo, wi)
+    crate::fixtures::far_patch(wo, wi)
 }
 
 /// Slope colour (sun only), environment only, and both combined multiplicatively with the
@@ -220,19 +220,19 @@ fn glint_rays_asks_for_millions_only_where_the_lobe_is_sharp() {
         direction(75f64.to_radians(), 0.0),
         direction(30f64.to_radians(), 0.0),
     );
-    let bumpy = Evaluator::new(&crate::eval::test_materials::preset("bumpy-specular")).unwrap();
-    let cfg = crate::eval::test_materials::far_patch(wo, wi);
+    let bumpy = Evaluator::new(&crate::fixtures::preset("bumpy-specular")).unwrap();
+    let cfg = crate::fixtures::far_patch(wo, wi);
     let mean = bumpy.ground_truth(&cfg, 4000, 1).mean;
     let n = bumpy.glint_rays(&cfg, mean, 0.01);
     assert!(n > 1e6 && n.is_finite(), "{n}");
     // A quarter of the precision asks for four times the rays.
     assert!((bumpy.glint_rays(&cfg, mean, 0.0025) / n - 4.0).abs() < 1e-9);
-    let default = Evaluator::new(&crate::eval::test_materials::preset("default")).unwrap();
-    let readme = crate::eval::test_materials::far_patch(wo, DVec3::Z);
+    let default = Evaluator::new(&crate::fixtures::preset("default")).unwrap();
+    let readme = crate::fixtures::far_patch(wo, DVec3::Z);
     let m = default.ground_truth(&readme, 4000, 1).mean;
     let d = default.glint_rays(&readme, m, 0.01);
     assert!(d > 0.0 && d < 40_000.0, "{d}");
-    let mut matte = crate::eval::test_materials::preset("default");
+    let mut matte = crate::fixtures::preset("default");
     matte.brdf.specular = 0.0;
     let matte = Evaluator::new(&matte).unwrap();
     assert_eq!(matte.glint_rays(&readme, m, 0.01), 0.0);

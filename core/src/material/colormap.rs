@@ -6,9 +6,9 @@
 //! [`Interpolation::Linear`], [`Interpolation::Smooth`] (smoothstep, C¹ at the stops) or
 //! [`Interpolation::Constant`] (each stop's colour holds until the next stop: a step map).
 
-use crate::material::preconvolved::{MARGIN_SIGMAS, PreconvolvedTable, TableSpec};
 use crate::material::validation::Problems;
 use crate::math::piecewise::{NCOEF, PiecewisePoly};
+use crate::math::preconvolved::{MARGIN_SIGMAS, PreconvolvedTable, TableSpec};
 use serde::{Deserialize, Serialize};
 
 /// Rec. 709 luminance weights of linear RGB: `Y = Σ LUMINANCE[c]·rgb[c]` (the error maps' and
@@ -206,7 +206,7 @@ impl Gradient {
     }
 
     /// The pre-convolved table [HNPN14 Sec. 4.2] over the stops' range widened by 4σ_max
-    /// (see [`crate::material::preconvolved`] for layout and border behaviour). Channel 3 holds 1.
+    /// (see [`crate::math::preconvolved`] for layout and border behaviour). Channel 3 holds 1.
     pub fn preconvolve(&self, spec: TableSpec) -> PreconvolvedTable {
         let spec = spec.sanitized();
         let (lo, hi) = self.range();

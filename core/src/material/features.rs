@@ -15,9 +15,9 @@
 //! the only path.
 
 use crate::driver::histogram::ImageHistogram;
-use crate::material::transfer::TransferFunction;
 use crate::material::{ColorModel, ColorSource, Driver, Material};
 use crate::microfacet::height_mixture::TransferSlopes;
+use crate::microfacet::transfer::TransferFunction;
 use crate::scene::shape::Shape;
 use glam::DVec3;
 use serde::{Deserialize, Serialize};

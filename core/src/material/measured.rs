@@ -187,7 +187,7 @@ mod tests {
     #[test]
     fn a_table_of_the_base_brdf_renders_like_it() {
         use crate::eval::Evaluator;
-        use crate::eval::test_materials::{far_patch, gaussian_material};
+        use crate::fixtures::{far_patch, gaussian_material};
         use crate::material::ColorModel;
         use crate::material::environment::{Environment, EnvironmentSource, Sky};
 

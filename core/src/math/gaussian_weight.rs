@@ -1,7 +1,7 @@
 //! A positive weight over the plane that is a Gaussian function,
 //! `w(z) = exp(c − ½ zᵀQz + bᵀz)`: closed under products and powers, with closed-form
 //! expectations under any Gaussian. What the transfer mixture's conditioned visibility is carried
-//! as ([`crate::eval::transfer_masking_table::TransferRays::visibility_weights`], #17): each ray's
+//! as ([`crate::eval::masking::transfer_masking_table::TransferRays::visibility_weights`], #17): each ray's
 //! conditioned `G1` from its own moments along its projection, their joint term `lo·hi^k` as a
 //! product, and its mean over a specular lobe's half-vector posterior as an expectation.
 //!

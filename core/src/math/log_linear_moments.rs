@@ -1,7 +1,7 @@
 //! Exact moments of `g(t) = exp(ℓ(t))` under a centred Gaussian `t ~ N(0, s²)`, for `ℓ`
 //! piecewise linear on increasing knots and constant beyond the first and last: `E[g]`,
 //! `E[t g]`, `E[t² g]`. What a conditioned masking table's column is (`ln G1` linear between its
-//! slope nodes, [`crate::eval::transfer_masking_table::entry_at`]), whose Gaussian moments the
+//! slope nodes, [`crate::eval::masking::transfer_masking_table::entry_at`]), whose Gaussian moments the
 //! transfer mixture needs.
 //!
 //! A Gauss–Hermite rule is the wrong tool for it: `ln G1` drops by up to 30 across one cell near

@@ -92,7 +92,7 @@ impl PiecewisePoly {
 
     /// The largest |p_ch(x)| over x ∈ [lo, hi], exact (up to rounding) for a channel of degree ≤ 2
     /// (both interval ends, the quadratic's vertex on each segment it crosses, the constant tails):
-    /// what the march needs of g′, the derivative channel of [`crate::material::transfer::Curve::moment_poly`]
+    /// what the march needs of g′, the derivative channel of [`crate::microfacet::transfer::Curve::moment_poly`]
     /// (a local Lipschitz constant of g). An empty or NaN interval (`!(lo <= hi)`) gives 0. Zero-width
     /// segments (jumps of p) contribute their neighbours' values only.
     pub fn max_abs_on(&self, ch: usize, lo: f64, hi: f64) -> f64 {

@@ -22,9 +22,9 @@
 //! lit are anti-correlated among a tread's points (terraces at 60°, light 60° opposite: the views'
 //! height-only visibility left the filtered view 7% too bright).
 
-use crate::material::transfer::TransferFunction;
 use crate::math::special::{norm_cdf, norm_pdf};
 use crate::microfacet::slope_masking::{ProcessGrid, conditioned_rate};
+use crate::microfacet::transfer::TransferFunction;
 
 /// `G(x) = g(σ_f x)/σ_f` tabulated for its inverse ([`TransferBarrier::inverse`]).
 #[derive(Clone, Debug, PartialEq)]
@@ -191,8 +191,8 @@ pub fn barrier_log_g1(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::transfer::{Curve, CurveInterpolation};
     use crate::microfacet::slope_masking::{LineProcess, conditioned_masking};
+    use crate::microfacet::transfer::{Curve, CurveInterpolation};
 
     fn process() -> LineProcess {
         LineProcess::new((0..48).map(|i| {

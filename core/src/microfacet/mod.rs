@@ -27,4 +27,5 @@ pub mod slope_masking;
 pub mod slope_rule;
 pub mod slopes;
 pub mod smith;
+pub mod transfer;
 pub mod visible_slopes;

@@ -17,7 +17,7 @@
 //! The views keep their height-correlated G2 and D_h and weight the visible (height, slope) pairs
 //! by G1 relative to Smith's, `r(h₀, t)` ([`JointMasking`]): each slope sees its own heights, and
 //! the mean visibility stays Smith's, only its share among the pairs moves
-//! ([`crate::eval::slope_weights`]). [`conditioned_masking`], the height-averaged profile
+//! ([`crate::eval::masking::slope_weights`]). [`conditioned_masking`], the height-averaged profile
 //! `E_h₀[G1(h₀, t)]`, is what session 18's views used (colour and slopes reweighted separately,
 //! which failed with the light opposite the view; docs/design.md); the measurements keep it.
 //!

@@ -90,10 +90,10 @@ impl DisplacedObject {
         let noise = SolidNoise::from_plane(plane, seed);
         let radius = shape.feature_radius();
         let reach = match &surface.transfer {
-            crate::material::transfer::TransferFunction::Identity => {
+            crate::microfacet::transfer::TransferFunction::Identity => {
                 surface.h_max.min(4.0 * surface.sigma_h)
             }
-            crate::material::transfer::TransferFunction::Curve(_) => surface.h_max,
+            crate::microfacet::transfer::TransferFunction::Curve(_) => surface.h_max,
         };
         if reach > MAX_RELIEF_FRACTION * radius {
             return Err(ObjectError::ReliefTooTall {

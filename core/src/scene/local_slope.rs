@@ -2,15 +2,15 @@
 //! steepest riser bounds g′ everywhere, but on the curve's flats g′ is far smaller, and the march
 //! only needs a bound over the range f can reach in one step (issue #15).
 
-use crate::material::table_slope::RowSlope;
 use crate::math::piecewise::PiecewisePoly;
+use crate::math::table_slope::RowSlope;
 
 /// A bound of |G′| over an interval of f, for the octave march's local steps.
 #[derive(Clone, Copy, Debug)]
 pub enum LocalSlope<'a> {
     /// The explicit surface, G = g: the largest |g′| over the interval, exact for the curve's
     /// piecewise quadratic g′ ([`PiecewisePoly::max_abs_on`] of the curve's
-    /// [`crate::material::transfer::Curve::moment_poly`], channel 2).
+    /// [`crate::microfacet::transfer::Curve::moment_poly`], channel 2).
     Curve(&'a PiecewisePoly),
     /// The level-of-detail surface, G = the pre-convolved table's mean at the footprint's σ_f as
     /// its sampler interpolates it: the largest slope of the table's two rows over the columns the
@@ -20,7 +20,7 @@ pub enum LocalSlope<'a> {
 }
 
 impl LocalSlope<'_> {
-    /// The channel of g′ in [`crate::material::transfer::Curve::moment_poly`].
+    /// The channel of g′ in [`crate::microfacet::transfer::Curve::moment_poly`].
     pub const DERIVATIVE_CHANNEL: usize = 2;
 
     /// A bound of |G′| on [lo, hi] (before the march's cap at its global bound).
@@ -35,12 +35,12 @@ impl LocalSlope<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::transfer::{Curve, TransferFunction};
     use crate::math::random::splitmix;
+    use crate::microfacet::transfer::{Curve, TransferFunction};
 
     /// On the explicit surface the bound holds g's difference quotients over random intervals of
     /// the sponge, moss and terraces curves (the table's bound has its own test in
-    /// [`crate::material::table_slope`]).
+    /// [`crate::math::table_slope`]).
     #[test]
     fn local_bounds_hold_the_curves() {
         let mut rng = 21u64;

@@ -7,9 +7,8 @@
 //! bound `K_d = σ_h · max|g′| · L_f(d̂_xy)` ([`crate::scene::march`]), as [`March`] selects.
 
 use crate::driver::field::DriverField;
-use crate::material::Material;
-use crate::material::transfer::TransferFunction;
 use crate::math::piecewise::PiecewisePoly;
+use crate::microfacet::transfer::TransferFunction;
 use crate::scene::bound_grid::{BoundGrid, GridView};
 use crate::scene::camera::Camera;
 use crate::scene::field_grid::{FieldGrid, FieldView};
@@ -42,7 +41,7 @@ pub struct Surface {
     /// The nested octave levels of a noise driver's fast march ([`crate::driver::noise::SumOfSines::level_ends`]; empty
     /// for an image).
     pub levels: Vec<usize>,
-    /// A transfer curve's [`crate::material::transfer::Curve::moment_poly`], built once (`None` for the identity): g and the
+    /// A transfer curve's [`crate::microfacet::transfer::Curve::moment_poly`], built once (`None` for the identity): g and the
     /// fast march's local Lipschitz constants of g ([`LocalSlope`]).
     pub transfer_poly: Option<PiecewisePoly>,
     /// Bounds of a noise driver over a region, which the octave march uses to skip what is clear
@@ -63,19 +62,11 @@ pub enum Trace {
 }
 
 impl Surface {
-    /// The surface of a noise-driven material (`None` for an image driver, which needs its image:
-    /// [`Surface::with_driver`]).
-    pub fn new(material: &Material) -> Option<Self> {
-        Some(Self::with_driver(
-            material,
-            DriverField::Noise(material.noise()?),
-        ))
-    }
-
-    /// The surface of `material` driven by `driver`.
-    pub fn with_driver(material: &Material, driver: DriverField) -> Self {
-        let sigma_h = material.heights.sigma_h.max(0.0);
-        let transfer = material.heights.transfer.clone();
+    /// The surface `h = σ_h·g(f)` of a driver under a transfer function (a material's:
+    /// [`Surface::new`] and [`Surface::with_driver`], in `material::geometry`). A negative σ_h
+    /// reads as 0.
+    pub fn from_parts(sigma_h: f64, transfer: TransferFunction, driver: DriverField) -> Self {
+        let sigma_h = sigma_h.max(0.0);
         let a = driver.amplitude_bound();
         let g_abs_max = match &transfer {
             TransferFunction::Identity => a,
@@ -263,7 +254,7 @@ impl Surface {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::material::{Heights, Slopes};
+    use crate::material::{Heights, Material, Slopes};
 
     fn surface() -> Surface {
         let m = Material {

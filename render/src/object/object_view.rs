@@ -8,13 +8,14 @@
 //! Pixels whose loops the adapter cut (Mesa's per-invocation loop budget, `bindings.wgsl`) are
 //! counted in [`ObjectImage::cut`]: a nonzero count says the image is not the tracer's answer.
 
+use crate::error::RenderError;
 use crate::gpu::GpuContext;
 use crate::gpu_codes::CorrelationCode;
 use crate::gpu_types::{MaterialParams, ObjectParams};
 use crate::object::voxel_store::GpuVoxels;
-use crate::renderer::{RenderError, read_words, storage_limit};
 use crate::shaders;
 use crate::specialize::specialize;
+use crate::view_target::{read_words, storage_limit};
 use glam::DVec3;
 use lodestone_core::material::features::{Feature, FeatureSet};
 use lodestone_core::microfacet::masking_shadowing::Correlation;

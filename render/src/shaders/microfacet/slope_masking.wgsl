@@ -1,5 +1,5 @@
 // Mirror of `core/src/microfacet/slope_masking.rs` (the lookup half: the masking itself is
-// tabulated on the CPU, `eval/slope_masking_table.wgsl`).
+// tabulated on the CPU, `eval/masking/slope_masking_table.wgsl`).
 // `//#if feature` blocks are stripped by render/src/specialize.rs when a scene does not use the feature.
 
 //#if relief
