@@ -264,7 +264,11 @@ fn the_graph_sees_super_paths_and_folder_cycles() {
     std::fs::create_dir_all(src.join("b")).unwrap();
     std::fs::write(src.join("lib.rs"), "pub mod a;\npub mod b;\n").unwrap();
     std::fs::write(src.join("a/mod.rs"), "pub mod x;\npub mod y;\n").unwrap();
-    std::fs::write(src.join("a/x.rs"), "use super::y::Y;\nuse crate::b::z::Z;\n").unwrap();
+    std::fs::write(
+        src.join("a/x.rs"),
+        "use super::y::Y;\nuse crate::b::z::Z;\n",
+    )
+    .unwrap();
     std::fs::write(
         src.join("a/y.rs"),
         "pub struct Y;\n#[cfg(test)]\nuse crate::a::x::X;\n",
@@ -275,8 +279,15 @@ fn the_graph_sees_super_paths_and_folder_cycles() {
     std::fs::write(src.join("b/tests.rs"), "use crate::a::x::X;\n").unwrap();
     let edges = module_graph(&src);
     assert!(edges["a::x"].contains("a::y"), "{edges:?}");
-    assert_eq!(edges["b::z"], BTreeSet::from(["a::y".to_string()]), "comments are no dependency");
-    assert!(!edges.contains_key("b::tests"), "test files are no dependency");
+    assert_eq!(
+        edges["b::z"],
+        BTreeSet::from(["a::y".to_string()]),
+        "comments are no dependency"
+    );
+    assert!(
+        !edges.contains_key("b::tests"),
+        "test files are no dependency"
+    );
     assert!(
         !edges["a::y"].contains("a::x"),
         "test code is no dependency"

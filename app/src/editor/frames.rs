@@ -175,6 +175,15 @@ impl EditorApp {
         }
     }
 
+    /// The march the views use: the fast one, or the reference (View → Debug).
+    fn march(&self) -> lodestone_core::scene::march::March {
+        if self.view.reference_march {
+            lodestone_core::scene::march::March::Reference
+        } else {
+            lodestone_core::scene::march::March::Fast
+        }
+    }
+
     /// Send the worker what the views need now, if it changed.
     pub(super) fn request_views(&mut self, ctx: &egui::Context) {
         if self.view_px[0] == 0 || self.view_px[1] == 0 {
@@ -191,6 +200,7 @@ impl EditorApp {
                 && r.truth_spp == truth_spp
                 && r.max_scale == self.view.max_scale
                 && r.adaptive_truth == self.view.adaptive_truth
+                && r.march == self.march()
         });
         if same {
             return;
@@ -213,6 +223,7 @@ impl EditorApp {
             truth_spp,
             max_scale: self.view.max_scale,
             adaptive_truth: self.view.adaptive_truth,
+            march: self.march(),
         };
         self.worker.request(req.clone());
         self.last_request = Some((self.doc.material.clone(), req));

@@ -128,6 +128,13 @@ impl EditorApp {
                 }
                 ui.separator();
                 ui.checkbox(&mut self.view.show_plots, "Plots");
+                ui.separator();
+                ui.menu_button("Debug", |ui| {
+                    ui.checkbox(&mut self.view.reference_march, "Reference march")
+                        .on_hover_text(
+                            "Render every view with the reference march (over-relaxed sphere tracing with one global Lipschitz bound) instead of the fast octave march: the same surface, slower; to compare the two in the editor",
+                        );
+                });
                 ui.checkbox(&mut self.report.open, "Error against run time report");
                 ui.checkbox(&mut self.object.open, "Object (voxel octree)")
                     .on_hover_text("A sphere, torus or mesh displaced by the material, voxelised and cone traced [HN12]");

@@ -94,9 +94,12 @@ pub struct ViewState {
     pub show_plots: bool,
     /// The object: the plane or a cylinder.
     pub shape: Shape,
-    /// Ground truth gives each pixel its own ray count from its predicted and measured noise
-    /// (#18 §1).
+    /// Ground truth gives each pixel its own ray count from its predicted and measured noise.
     pub adaptive_truth: bool,
+    /// Every view marches with the reference march instead of the fast one (View → Debug; not
+    /// kept across sessions), so both are one click apart.
+    #[serde(skip)]
+    pub reference_march: bool,
     /// What the ground-truth viewport shows: its image or one of its noise maps.
     pub truth_display: TruthDisplay,
 }
@@ -204,6 +207,7 @@ impl Default for ViewState {
             show_plots: true,
             shape: Shape::Plane,
             adaptive_truth: false,
+            reference_march: false,
             truth_display: TruthDisplay::Image,
         }
     }

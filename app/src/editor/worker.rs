@@ -12,11 +12,13 @@
 //!
 //! checking for a newer request between passes.
 
+mod truth;
 use lodestone_core::driver::image::ImageDriver;
 use lodestone_core::eval::Evaluator;
 use lodestone_core::material::Material;
 use lodestone_core::material::measured::MeasuredBrdf;
 use lodestone_core::math::sh::Sh9;
+use lodestone_core::scene::march::March;
 use lodestone_render::adaptive_truth::{Progressive, ray_costs, render_progressive};
 use lodestone_render::truth_noise::SampleMoments;
 use lodestone_render::{
@@ -51,6 +53,8 @@ pub struct Request {
     pub max_scale: f32,
     /// Ground truth gives each pixel its own ray count from the predicted and measured noise.
     pub adaptive_truth: bool,
+    /// How every view's rays march (the fast march, or the reference kept selectable).
+    pub march: March,
 }
 
 /// A finished image of one mode.
@@ -309,6 +313,7 @@ impl State {
         image: &Option<Arc<ImageDriver>>,
         environment: &Option<Sh9>,
         measured: &Option<Arc<MeasuredBrdf>>,
+        march: March,
         send: &dyn Fn(Event),
     ) -> bool {
         let same_image = |p: &Evaluator| match (p.surface.driver.image(), image) {
@@ -318,7 +323,10 @@ impl State {
         };
         if let Some((m, _)) = &self.material
             && (Arc::ptr_eq(m, material) || **m == **material)
-            && self.prepared.as_ref().is_some_and(same_image)
+            && self
+                .prepared
+                .as_ref()
+                .is_some_and(|p| same_image(p) && p.surface.march == march)
             && self.environment == *environment
             && match (&self.measured, measured) {
                 (None, None) => true,
@@ -330,7 +338,7 @@ impl State {
         }
         match Evaluator::with_image(material, image.clone(), self.prepared.as_ref()) {
             Ok(mut p) => {
-                p.surface.march = march_setting();
+                p.surface.march = march;
                 if let Some(sh) = environment {
                     p.set_environment_radiance(sh);
                 }
@@ -410,6 +418,7 @@ impl State {
             &req.image,
             &req.environment,
             &req.measured,
+            req.march,
             send,
         ) {
             return Ok(None);
@@ -490,159 +499,6 @@ impl State {
             },
         }
     }
-
-    /// Adaptive ground truth (#18 §1): core predicts each pixel's ray deviation once (on a grid
-    /// of at most [`PREDICT_SIDE`] pixels a side, nearest-upsampled: the allocation needs its
-    /// shape, not its detail), then [`render_progressive`] traces rounds of doubling budgets up to
-    /// `truth_spp` rays per pixel on average, each in steps of about one ray per pixel, so a newer
-    /// request waits no longer than for a uniform frame.
-    fn accumulate_adaptive(
-        &mut self,
-        req: &Request,
-        scale: f32,
-        rx: &Receiver<Request>,
-        send: &dyn Fn(Event),
-    ) -> Result<Option<Request>, ()> {
-        let size = Self::size_at(req, scale);
-        let Some(mut target) = self.truth_target(size, send) else {
-            return Ok(None);
-        };
-        let (Some(prepared), Some((_, gm))) = (&self.prepared, &self.material) else {
-            self.truth = Some(target);
-            return Ok(None);
-        };
-        let predicted = predicted_deviation(prepared, &req.scene, size);
-        let predicted_f32 = Arc::new(predicted.iter().map(|v| *v as f32).collect::<Vec<_>>());
-        let bandwidth = Arc::new(predicted_bandwidth(prepared, &req.scene, size));
-        let spp = req.truth_spp.max(1);
-        let plan = Progressive {
-            predicted: &predicted,
-            rays_per_pixel: f64::from(spp),
-            max_rays: spp.saturating_mul(MAX_RAYS_FACTOR).max(16),
-            // Measured in `lodestone report` (docs/design.md): on llvmpipe the cost-aware plan
-            // lost to the plain one at equal error in time as well as in rays.
-            cost_aware: false,
-        };
-        let renderer = &self.renderer;
-        let mut outcome: Result<Option<Request>, ()> = Ok(None);
-        let mut last_sent = Instant::now() - Duration::from_secs(1);
-        let mut t0 = Instant::now();
-        let traced = render_progressive(
-            renderer,
-            &mut target,
-            gm,
-            &req.scene,
-            plan,
-            |target, rays, round_end| {
-                renderer.wait();
-                let dt = t0.elapsed();
-                let total: u64 = rays.iter().map(|r| u64::from(*r)).sum();
-                let mean = (total as f64 / rays.len().max(1) as f64).round() as u32;
-                if round_end || last_sent.elapsed() > Duration::from_millis(120) {
-                    let image = target.read(renderer)?;
-                    let moments = target.read_moments(renderer)?;
-                    let cut_rays = target.cut_count(renderer)?;
-                    let cost = costs_f32(&target.read_work(renderer)?, rays);
-                    send(Event::Frame(Frame {
-                        generation: req.generation,
-                        mode: ViewMode::Truth,
-                        image: Arc::new(image),
-                        samples: mean,
-                        rays: Some(Arc::new(rays.to_vec())),
-                        predicted_sd: Some(predicted_f32.clone()),
-                        predicted_bandwidth: Some(bandwidth.clone()),
-                        cost: Some(Arc::new(cost)),
-                        moments: Some(Arc::new(moments)),
-                        pass_time: dt,
-                        cut_rays,
-                        scale,
-                    }));
-                    last_sent = Instant::now();
-                }
-                t0 = Instant::now();
-                match Self::newest(rx) {
-                    Err(()) => outcome = Err(()),
-                    Ok(Some(newer)) => outcome = Ok(Some(newer)),
-                    Ok(None) => return Ok(true),
-                }
-                Ok(false)
-            },
-        );
-        if let Err(e) = traced {
-            send(Event::RenderError(e.to_string()));
-        }
-        self.truth = Some(target);
-        outcome
-    }
-
-    fn accumulate_truth(
-        &mut self,
-        req: &Request,
-        scale: f32,
-        rx: &Receiver<Request>,
-        send: &dyn Fn(Event),
-    ) -> Result<Option<Request>, ()> {
-        let size = Self::size_at(req, scale);
-        let Some(mut target) = self.truth_target(size, send) else {
-            return Ok(None);
-        };
-        target.reset();
-        let mut last_sent = Instant::now() - Duration::from_secs(1);
-        let result = loop {
-            let Some((_, gm)) = &self.material else {
-                break Ok(None);
-            };
-            let t0 = Instant::now();
-            self.renderer
-                .draw(&mut target, gm, &req.scene, ViewMode::Truth, 1);
-            self.renderer.wait();
-            let dt = t0.elapsed();
-            let done = target.samples >= req.truth_spp;
-            // Read back at most ~8 times a second (and always at the end): readback costs a copy.
-            if done || last_sent.elapsed() > Duration::from_millis(120) || target.samples <= 4 {
-                let read = target.read(&self.renderer).and_then(|image| {
-                    Ok((
-                        image,
-                        target.read_moments(&self.renderer)?,
-                        target.cut_count(&self.renderer)?,
-                        target.read_work(&self.renderer)?,
-                    ))
-                });
-                match read {
-                    Ok((image, moments, cut_rays, work)) => send(Event::Frame(Frame {
-                        generation: req.generation,
-                        mode: ViewMode::Truth,
-                        image: Arc::new(image),
-                        samples: target.samples,
-                        rays: None,
-                        predicted_sd: None,
-                        predicted_bandwidth: None,
-                        cost: Some(Arc::new(costs_f32(
-                            &work,
-                            &vec![target.samples; work.len()],
-                        ))),
-                        moments: Some(Arc::new(moments)),
-                        pass_time: dt,
-                        cut_rays,
-                        scale,
-                    })),
-                    Err(e) => {
-                        send(Event::RenderError(e.to_string()));
-                        break Ok(None);
-                    }
-                }
-                last_sent = Instant::now();
-            }
-            match Self::newest(rx) {
-                Err(()) => break Err(()),
-                Ok(Some(newer)) => break Ok(Some(newer)),
-                Ok(None) if done => break Ok(None),
-                Ok(None) => {}
-            }
-        };
-        self.truth = Some(target);
-        result
-    }
 }
 
 /// Longest side of the grid on which an adaptive truth's ray deviation is predicted (core, on the
@@ -689,182 +545,5 @@ fn costs_f32(work: &[u32], rays: &[u32]) -> Vec<f32> {
         .collect()
 }
 
-/// The hidden editor setting for the march (issue #15: every speed-up is a ratio measured in one
-/// run): `LODESTONE_MARCH=reference` renders the views with the reference march, anything else (or
-/// nothing) with the fast one.
-fn march_setting() -> lodestone_core::scene::march::March {
-    use lodestone_core::scene::march::March;
-    match std::env::var("LODESTONE_MARCH").as_deref() {
-        Ok("reference") => March::Reference,
-        _ => March::Fast,
-    }
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use lodestone_core::scene::camera::Camera;
-    use lodestone_core::scene::direction::direction;
-    use lodestone_core::scene::shape::Shape;
-
-    fn request(generation: u64, spp: u32) -> Request {
-        Request {
-            generation,
-            material: Arc::new(Material::default()),
-            image: None,
-            environment: None,
-            measured: None,
-            scene: Scene {
-                camera: Camera::default(),
-                light: direction(0.5, 1.0),
-                shape: Shape::Plane,
-            },
-            size: [32, 24],
-            modes: vec![ViewMode::Naive, ViewMode::Filtered, ViewMode::Truth],
-            truth_spp: spp,
-            max_scale: 1.0,
-            adaptive_truth: false,
-        }
-    }
-
-    /// A headless worker whose device is up, or `None` (logged as skipped as `test`) without an
-    /// adapter.
-    fn ready_worker(test: &str) -> Option<Worker> {
-        let w = Worker::spawn(DeviceSource::Headless, || {});
-        match w.wait(Duration::from_secs(60)) {
-            Some(Event::Ready { .. }) => Some(w),
-            Some(Event::NoAdapter(e)) => {
-                lodestone_tests::skip(test, e);
-                None
-            }
-            other => panic!("unexpected {other:?}"),
-        }
-    }
-
-    /// A panic while serving (as a driver's) ends the thread with `Stopped` and its message,
-    /// instead of leaving the window waiting; dropping the worker then joins it cleanly.
-    #[test]
-    fn a_panic_in_the_render_thread_is_reported() {
-        let Some(w) = ready_worker("the worker panic test") else {
-            return;
-        };
-        w.request(request(PANIC_GENERATION, 1));
-        match w.wait(Duration::from_secs(60)) {
-            Some(Event::Stopped(msg)) => assert!(msg.contains("injected"), "{msg}"),
-            other => panic!("unexpected {other:?}"),
-        }
-        drop(w);
-    }
-
-    /// The worker renders every requested mode, refines to full size, and accumulates exactly
-    /// the requested truth samples.
-    #[test]
-    fn serves_every_mode_up_to_full_resolution() {
-        let Some(w) = ready_worker("the worker test") else {
-            return;
-        };
-        w.request(request(7, 3));
-        let mut full = Vec::new();
-        let mut truth_spp = 0;
-        while let Some(ev) = w.wait(Duration::from_secs(120)) {
-            let Event::Frame(f) = ev else {
-                panic!("unexpected {ev:?}")
-            };
-            assert_eq!(f.generation, 7);
-            assert!(f.image.pixels.iter().flatten().all(|v| v.is_finite()));
-            if f.scale == 1.0 {
-                assert_eq!((f.image.width, f.image.height), (32, 24));
-                full.push(f.mode);
-            }
-            if f.mode == ViewMode::Truth {
-                truth_spp = f.samples;
-                if f.samples == 3 {
-                    break;
-                }
-            }
-        }
-        assert!(full.contains(&ViewMode::Naive) && full.contains(&ViewMode::Filtered));
-        assert_eq!(truth_spp, 3);
-    }
-
-    /// Adaptive ground truth spends the requested rays per pixel on average, gives pixels
-    /// different counts, traces exactly those (each pixel's weight is its count), and gives the
-    /// pixels the prediction calls noisier more rays.
-    #[test]
-    fn adaptive_truth_gives_each_pixel_its_planned_rays() {
-        let w = Worker::spawn(DeviceSource::Headless, || {});
-        match w.wait(Duration::from_secs(60)) {
-            Some(Event::Ready { adapter, .. }) => {
-                lodestone_tests::ran("adaptive_truth_gives_each_pixel_its_planned_rays", &adapter)
-            }
-            Some(Event::NoAdapter(e)) => {
-                lodestone_tests::skip("the adaptive worker test", e);
-                return;
-            }
-            other => panic!("unexpected {other:?}"),
-        }
-        let mut req = request(9, 8);
-        req.adaptive_truth = true;
-        req.modes = vec![ViewMode::Truth];
-        // Grazing, the sun low on the far side: glints and shadows make the noise uneven.
-        req.scene.camera.elevation_deg = 75.0;
-        req.scene.camera.distance = 3.0;
-        req.scene.light = direction(1.2, 0.0);
-        w.request(req);
-        let mut last = None;
-        while let Some(ev) = w.wait(Duration::from_secs(300)) {
-            let Event::Frame(f) = ev else {
-                panic!("unexpected {ev:?}")
-            };
-            if f.mode != ViewMode::Truth {
-                continue;
-            }
-            assert!(f.image.pixels.iter().flatten().all(|v| v.is_finite()));
-            let done = f.samples >= 8;
-            last = Some(f);
-            if done {
-                break;
-            }
-        }
-        let f = last.expect("a truth frame");
-        let rays = f.rays.as_deref().expect("an adaptive truth's ray counts");
-        let sd = f.predicted_sd.as_deref().expect("its prediction");
-        let n = 32 * 24;
-        assert_eq!((rays.len(), sd.len()), (n, n));
-        // The predicted bandwidth came with it: the sky 0, the horizon Nyquist's, the rest between.
-        let b = f.predicted_bandwidth.as_deref().expect("its bandwidth");
-        assert_eq!(b.len(), n);
-        assert!(b.iter().all(|v| (0.0..=0.5).contains(v)), "{b:?}");
-        assert!(b.contains(&0.0) && b.contains(&0.5) && b.iter().any(|v| *v > 0.0 && *v < 0.5));
-        let total: u32 = rays.iter().sum();
-        assert!(total.abs_diff(8 * n as u32) <= 1, "{total} rays");
-        // Traced as planned: each pixel's weight is its ray count.
-        for (p, r) in f.image.pixels.iter().zip(rays) {
-            assert_eq!(p[3], *r as f32);
-        }
-        let (lo, hi) = (rays.iter().min().unwrap(), rays.iter().max().unwrap());
-        assert!(*lo >= 1 && hi > lo, "rays {lo}..{hi}");
-        // Noisier predicted pixels got more rays on average.
-        let cost = f.cost.as_deref().expect("its costs");
-        assert!(cost.iter().all(|c| *c >= 1.0));
-        let mut order: Vec<usize> = (0..n).collect();
-        order.sort_by(|a, b| sd[*a].total_cmp(&sd[*b]));
-        let mean =
-            |ix: &[usize]| ix.iter().map(|&p| f64::from(rays[p])).sum::<f64>() / ix.len() as f64;
-        let (quiet, noisy) = (mean(&order[..n / 4]), mean(&order[3 * n / 4..]));
-        eprintln!("rays {lo}..{hi}: quietest quarter {quiet}, noisiest {noisy}");
-        assert!(
-            noisy > 1.5 * quiet,
-            "rays: quietest quarter {quiet}, noisiest {noisy}"
-        );
-    }
-
-    #[test]
-    fn reports_a_missing_adapter() {
-        let w = Worker::spawn(DeviceSource::Unavailable, || {});
-        assert!(matches!(
-            w.wait(Duration::from_secs(10)),
-            Some(Event::NoAdapter(_))
-        ));
-    }
-}
+mod tests;

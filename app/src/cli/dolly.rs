@@ -8,13 +8,58 @@
 //! Ground truth is left out: its one-ray frames jump by their Monte Carlo noise, which would hide
 //! any popping (and it has no level of detail to pop).
 
+use crate::cli::Context;
+use crate::cli::args;
+use crate::cli::render::{View, renderer};
 use crate::preset_io::Resolved;
-use crate::render_cmd::{View, renderer};
 use anyhow::Result;
 use glam::DVec2;
 use lodestone_core::eval::Method;
 use lodestone_core::scene::march::March;
 use lodestone_render::{GpuMaterial, LinearImage, ViewMode, ViewTarget};
+
+/// The arguments of `lodestone dolly`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct DollyArgs {
+    /// Camera angle from the normal, degrees (0 to 89.5).
+    #[arg(long, default_value_t = 77.0, value_parser = args::view_angle)]
+    pub view_deg: f64,
+    /// Closest camera distance (world units).
+    #[arg(long, default_value_t = 0.15, value_parser = args::distance)]
+    pub from: f64,
+    /// Farthest camera distance (world units).
+    #[arg(long, default_value_t = 400.0, value_parser = args::distance)]
+    pub to: f64,
+    /// Frames along the dolly (2 to 10000).
+    #[arg(long, default_value_t = 120, value_parser = clap::value_parser!(u32).range(2..=10000))]
+    pub frames: u32,
+    /// Image size, WxH.
+    #[arg(long, default_value = "160x120", value_parser = args::parse_size)]
+    pub size: (u32, u32),
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Measure popping over the dolly and print the table (or JSON).
+pub fn run_command(args: DollyArgs, ctx: &Context) -> Result<()> {
+    let opts = Options {
+        view_deg: args.view_deg,
+        range: (args.from, args.to),
+        frames: args.frames,
+        size: args.size,
+    };
+    let (adapter, rows) = run(&ctx.preset, &opts)?;
+    if args.json {
+        outln!(
+            "{}",
+            serde_json::to_string_pretty(&to_json(&rows, &opts, &adapter))?
+        );
+    } else {
+        out!("{}", table(&rows, &opts, &adapter));
+    }
+    Ok(())
+}
 
 /// What `lodestone dolly` sweeps.
 #[derive(Clone, Debug)]

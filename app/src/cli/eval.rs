@@ -1,10 +1,64 @@
 //! `lodestone eval`: the CPU reference evaluation of a far patch under every method.
 
+use crate::cli::Context;
+use crate::cli::args;
 use crate::preset_io::Resolved;
 use anyhow::Result;
 use lodestone_core::eval::FootprintQuery;
 use lodestone_core::scene::direction::direction;
 use serde::Serialize;
+
+/// The arguments of `lodestone eval`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct EvalArgs {
+    /// View angle from the normal, degrees (0 to 89.5).
+    #[arg(long, default_value_t = 0.0, value_parser = args::view_angle)]
+    pub view_deg: f64,
+    /// View azimuth, degrees.
+    #[arg(long, default_value_t = 0.0, value_parser = args::azimuth)]
+    pub view_azimuth_deg: f64,
+    /// Light angle from the normal, degrees (0 to 180; past 90 the sun is below the horizon).
+    #[arg(long, default_value_t = 0.0, value_parser = args::light_angle)]
+    pub light_deg: f64,
+    /// Light azimuth, degrees.
+    #[arg(long, default_value_t = 0.0, value_parser = args::azimuth)]
+    pub light_azimuth_deg: f64,
+    /// Ground-truth samples (eye rays) for the patch (2 to 10⁸: its standard error needs two).
+    #[arg(long, default_value_t = 40_000, value_parser = args::eval_samples)]
+    pub spp: usize,
+    /// The filtered model's masking of the visible slopes, overriding the preset's: Smith's
+    /// (height alone), or conditioned on the facet's height and slope along the ray jointly
+    /// (the default; noise drivers).
+    #[arg(long, value_enum)]
+    pub slope_masking: Option<args::SlopeMaskingArg>,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Evaluate the far patch and print the table (or JSON).
+pub fn run(args: EvalArgs, ctx: &Context) -> Result<()> {
+    let mut preset = ctx.preset.clone();
+    if let Some(sm) = args.slope_masking {
+        preset.material.filtering.slope_masking = sm.into();
+    }
+    let r = eval(
+        &preset,
+        [
+            args.view_deg,
+            args.view_azimuth_deg,
+            args.light_deg,
+            args.light_azimuth_deg,
+        ],
+        args.spp,
+    )?;
+    if args.json {
+        outln!("{}", serde_json::to_string_pretty(&r)?);
+    } else {
+        out!("{}", table(&r));
+    }
+    Ok(())
+}
 
 /// The result of `eval`, also its JSON form.
 #[derive(Debug, Serialize)]

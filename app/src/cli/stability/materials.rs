@@ -4,7 +4,8 @@
 //! ≥ 0) and checked against a [`Reference`]: an exact identity of the model or a limit, computed
 //! through other materials or other outputs.
 
-use crate::stability_cases::{Path, Row, deviation};
+use crate::cli::stability::inputs::{ramp, step_map, vertical_curve};
+use crate::cli::stability::row::{Path, Row, deviation};
 use glam::DVec3;
 use lodestone_core::driver::footprint::Footprint;
 use lodestone_core::driver::image::ImageDriver;
@@ -15,7 +16,7 @@ use lodestone_core::material::environment::{Environment, EnvironmentSource, Ligh
 use lodestone_core::material::slope_color::SlopeColor;
 use lodestone_core::material::{ColorModel, ColorSource, Heights, Material, Slopes};
 use lodestone_core::microfacet::slope_masking::SlopeMasking;
-use lodestone_core::microfacet::transfer::{Curve, TransferFunction};
+use lodestone_core::microfacet::transfer::TransferFunction;
 use lodestone_core::scene::direction::direction;
 use std::f64::consts::FRAC_PI_2;
 use std::sync::Arc;
@@ -402,62 +403,11 @@ pub fn material_cases() -> Vec<MaterialCase> {
     out
 }
 
-/// A red/blue step colour map (Constant interpolation) with steps at ±0.5.
-pub fn step_map() -> Gradient {
-    Gradient {
-        stops: vec![
-            ColorStop {
-                position: -0.5,
-                color: [0.9, 0.1, 0.1],
-            },
-            ColorStop {
-                position: 0.5,
-                color: [0.1, 0.1, 0.9],
-            },
-        ],
-        interpolation: Interpolation::Constant,
-    }
-}
-
-/// `map` (Constant interpolation) as a Linear map: each step becomes a ramp 1e-7 wide ending at
-/// the step.
-pub fn ramp(map: &Gradient) -> Gradient {
-    let mut stops = vec![];
-    for (i, s) in map.stops.iter().enumerate() {
-        if i > 0 {
-            stops.push(ColorStop {
-                position: s.position - 1e-7,
-                color: map.stops[i - 1].color,
-            });
-        }
-        stops.push(*s);
-    }
-    Gradient {
-        stops,
-        interpolation: Interpolation::Linear,
-    }
-}
-
 /// The colour map of [`base`].
 fn base_map() -> Gradient {
     match base().color {
         ColorModel::Gradient { map, .. } => map,
         _ => unreachable!("the default material has a colour map"),
-    }
-}
-
-/// Terraces with exactly vertical risers (equal f at both ends of each riser).
-pub fn vertical_curve() -> Curve {
-    Curve {
-        points: vec![
-            [-2.0, -1.0],
-            [-0.5, -1.0],
-            [-0.5, 0.0],
-            [0.5, 0.0],
-            [0.5, 1.0],
-            [2.0, 1.0],
-        ],
-        interpolation: lodestone_core::microfacet::transfer::CurveInterpolation::Linear,
     }
 }
 
@@ -624,49 +574,4 @@ pub fn material_rows() -> Vec<Row> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The references are not the cases themselves, and they can fail: a 1% brighter diffuse
-    /// colour or the untransposed anisotropy is caught.
-    #[test]
-    fn references_catch_a_wrong_answer() {
-        for case in material_cases() {
-            if let Reference::Same { material, .. } = &case.reference {
-                assert_ne!(**material, case.material, "{}", case.name);
-            }
-        }
-        // The anisotropy case against its reference without the mirror: not the same.
-        let r = 1e6f64;
-        let p = procedural(&with_sigmas(0.05, 0.35 * r.sqrt(), 0.35 / r.sqrt()));
-        let q = procedural(&with_sigmas(0.05, 0.35 / r.sqrt(), 0.35 * r.sqrt()));
-        let (a, b) = (
-            compared_statistics(&p, AZIMUTHS),
-            compared_statistics(&q, AZIMUTHS),
-        );
-        let dev = a
-            .iter()
-            .zip(&b)
-            .map(|(x, y)| deviation(*x, *y, 1e-3))
-            .fold(0.0, f64::max);
-        assert!(dev > 1e-2, "{dev}");
-        // A 1% brighter attribute mean is off the clamped-attribute reference.
-        let case = material_cases()
-            .into_iter()
-            .find(|c| matches!(c.reference, Reference::ClampedAttribute { .. }))
-            .expect("the attribute case");
-        let p = procedural(&case.material);
-        let want = expected(&case, &p);
-        let mut brighter = case.material.clone();
-        if let ColorModel::Attribute { mean, .. } = &mut brighter.color {
-            mean[1] *= 1.01;
-        }
-        let got = compared_statistics(&procedural(&brighter), AZIMUTHS);
-        let dev = got
-            .iter()
-            .zip(&want)
-            .map(|(x, y)| deviation(*x, *y, 1e-3))
-            .fold(0.0, f64::max);
-        assert!(dev > 1e-3, "{dev}");
-    }
-}
+mod tests;

@@ -13,6 +13,8 @@
 //! reached: glints make it noisy (the bumpy-specular preset needs ~10⁶ rays for 2%), and an
 //! error within three standard errors is not an error.
 
+use crate::cli::Context;
+use crate::cli::args;
 use crate::preset_io::Resolved;
 use anyhow::Result;
 use lodestone_core::eval::FootprintQuery;
@@ -20,6 +22,55 @@ use lodestone_core::material::color_terms::ColorTerms;
 use lodestone_core::material::{ColorModel, Material};
 use lodestone_core::scene::direction::direction;
 use serde::Serialize;
+
+/// The arguments of `lodestone diagnose`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct DiagnoseArgs {
+    /// View angles from the normal, degrees (0 to 89.5), comma-separated.
+    #[arg(long, default_value = "0,45,75", value_delimiter = ',', value_parser = args::view_angle)]
+    pub view_deg: Vec<f64>,
+    /// Light angles from the normal, degrees (0 to 180), comma-separated.
+    #[arg(long, default_value = "0,30", value_delimiter = ',', value_parser = args::light_angle)]
+    pub light_deg: Vec<f64>,
+    /// Light azimuths, degrees (the view's is 0: 0 puts the light on the viewer's side, 180
+    /// opposite), comma-separated.
+    #[arg(long, default_value = "0,180", value_delimiter = ',', value_parser = args::azimuth)]
+    pub light_azimuth_deg: Vec<f64>,
+    /// Sample the truth until its relative standard error is below this (0.0001 to 0.5).
+    #[arg(long, default_value_t = 0.005, value_parser = args::precision)]
+    pub precision: f64,
+    /// At most this many ground-truth rays per variant and configuration (2 to 10⁸).
+    #[arg(long, default_value_t = 2_000_000, value_parser = args::eval_samples)]
+    pub max_spp: usize,
+    /// Only the material itself, no variants (an accuracy grid over many configurations).
+    #[arg(long)]
+    pub full_only: bool,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Diagnose the material over the grid and print the table (or JSON).
+pub fn run(args: DiagnoseArgs, ctx: &Context) -> Result<()> {
+    let preset = &ctx.preset;
+    let rows = diagnose(
+        preset,
+        &Grid {
+            views: &args.view_deg,
+            lights: &args.light_deg,
+            azimuths: &args.light_azimuth_deg,
+        },
+        args.precision,
+        args.max_spp,
+        args.full_only,
+    )?;
+    if args.json {
+        outln!("{}", serde_json::to_string_pretty(&rows)?);
+    } else {
+        out!("{}", table(&preset.material.name, &rows));
+    }
+    Ok(())
+}
 
 /// One variant at one configuration.
 #[derive(Debug, Serialize)]

@@ -1,18 +1,25 @@
 //! `lodestone stability`: core's stiff and extreme cases (f64 and the f32 mirror, see
-//! [`crate::stability_cases`]) plus the same cases through the WGSL on the GPU adapter.
+//! [`crate::cli::stability::cases`]) plus the same cases through the WGSL on the GPU adapter.
 //!
 //! WGSL rows: the special functions on the same arguments (bound 1e-5·(1 + κ) relative, κ the
-//! condition number, [`crate::stability_cases::f32_deviation`]: WGSL lets
+//! condition number, [`crate::cli::stability::cases::f32_deviation`]: WGSL lets
 //! `exp`/`log` be off by a few ULP more than Rust's), and every material case rendered far away
 //! (8×8 pixels, camera at the listed angles from the normal plus 60°, every mode, the ground truth
 //! with 1 ray where core traces it too, [`stability::truth_traceable`]): non-finite or negative pixels
 //! are failures; the deviation is the fraction of pixels
 //! below 89.9° whose analytic value differs from core's evaluation of that pixel by more than
 //! 0.5% + 2e-4 (bound 2%: f32 against f64 rays may cross a shadow edge differently).
-//! `LODESTONE_STABILITY_DEBUG=1` prints every failing WGSL pixel.
+//! `RUST_LOG=lodestone=debug` logs every failing WGSL pixel.
 
-use crate::stability_cases::{Path, Row, SpecialFunction};
-use crate::stability_materials::{self as stability, material_cases};
+pub mod cases;
+pub mod inputs;
+pub mod materials;
+pub mod row;
+
+use crate::cli::Context;
+use crate::cli::stability::cases::SpecialFunction;
+use crate::cli::stability::materials::{self as stability, material_cases};
+use crate::cli::stability::row::{Path, Row};
 use anyhow::Result;
 use glam::DVec2;
 use lodestone_core::eval::{Evaluator, Method};
@@ -20,6 +27,23 @@ use lodestone_core::scene::camera::Camera;
 use lodestone_core::scene::direction::direction;
 use lodestone_core::scene::shape::Shape;
 use lodestone_render::{GpuContext, GpuMaterial, Renderer, Scene, ViewMode, compute, shaders};
+
+/// The arguments of `lodestone stability`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct StabilityArgs {
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Only core's f64 and f32 rows (without it, no GPU adapter is exit code 3: the WGSL rows
+    /// did not run).
+    #[arg(long)]
+    pub cpu_only: bool,
+}
+
+/// Run every case and print the table (or JSON); exit code 1 when a row fails.
+pub fn run_command(args: StabilityArgs, _ctx: &Context) -> Result<()> {
+    run(args.json, args.cpu_only)
+}
 
 fn wgsl_special_rows(ctx: &GpuContext) -> Vec<Row> {
     SpecialFunction::ALL
@@ -35,7 +59,9 @@ fn wgsl_special_rows(ctx: &GpuContext) -> Vec<Row> {
                 if !g.is_finite() {
                     bad += 1;
                 }
-                dev = dev.max(crate::stability_cases::f32_deviation(function, *xs32, g));
+                dev = dev.max(crate::cli::stability::cases::f32_deviation(
+                    function, *xs32, g,
+                ));
             }
             Row {
                 case: format!("{name} at {} extreme arguments", xs.len()),
@@ -109,8 +135,8 @@ fn wgsl_material_rows(r: &Renderer) -> Vec<Row> {
                             let got = img.rgb(x, y);
                             outputs += 3;
                             let nb = got.iter().filter(|v| !v.is_finite() || **v < 0.0).count();
-                            if nb > 0 && std::env::var("LODESTONE_STABILITY_DEBUG").is_ok() {
-                                eprintln!("{} {mode:?} {deg}° ({x},{y}): {got:?}", case.name);
+                            if nb > 0 {
+                                log::debug!("{} {mode:?} {deg}° ({x},{y}): {got:?}", case.name);
                             }
                             bad += nb;
                             let method = match mode {
@@ -137,8 +163,8 @@ fn wgsl_material_rows(r: &Renderer) -> Vec<Row> {
                             if (0..3).any(|k| {
                                 (f64::from(got[k]) - want[k]).abs() > 5e-3 * want[k].abs() + 2e-4
                             }) {
-                                if std::env::var("LODESTONE_STABILITY_DEBUG").is_ok() && off < 3 {
-                                    eprintln!(
+                                if off < 3 {
+                                    log::debug!(
                                         "{} {mode:?} {deg}° ({x},{y}): GPU {got:?} core {want:?}",
                                         case.name
                                     );
@@ -173,7 +199,7 @@ fn wgsl_material_rows(r: &Renderer) -> Vec<Row> {
 /// Every row: CPU, then (unless `cpu_only`) WGSL on the adapter, and the reason there are no WGSL
 /// rows when no adapter was found.
 pub fn rows(cpu_only: bool) -> (Vec<Row>, Option<lodestone_render::GpuError>) {
-    let mut rows = crate::stability_cases::cpu_rows();
+    let mut rows = crate::cli::stability::cases::cpu_rows();
     if cpu_only {
         return (rows, None);
     }

@@ -5,8 +5,10 @@
 //! entry point), the GPU data by part against what the all-features pipeline needs, and with
 //! `--time` the pipeline compile times and frame times of both on the adapter.
 
+use crate::cli::Context;
+use crate::cli::args;
+use crate::cli::render::{View, frame_ms_interleaved, renderer};
 use crate::preset_io::Resolved;
-use crate::render_cmd::{View, frame_ms_interleaved, renderer};
 use anyhow::Result;
 use lodestone_core::material::features::FeatureSet;
 use lodestone_render::material_data::material_data_for;
@@ -14,6 +16,61 @@ use lodestone_render::specialize::{ShaderSize, view_source_for};
 use lodestone_render::{GpuMaterial, ViewMode, ViewTarget};
 use serde_json::{Value, json};
 use std::time::{Duration, Instant};
+
+/// The arguments of `lodestone inspect`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct InspectArgs {
+    /// Print JSON.
+    #[arg(long)]
+    pub json: bool,
+    /// Light angle from the normal, degrees (0 puts it at the normal: no shadow rays; 0 to 180).
+    #[arg(long, default_value_t = 30.0, value_parser = args::light_angle)]
+    pub light_deg: f64,
+    /// Light azimuth, degrees.
+    #[arg(long, default_value_t = 90.0, value_parser = args::azimuth)]
+    pub light_azimuth_deg: f64,
+    /// The object: the plane, or a cylinder of radius 2.
+    #[arg(long, value_enum, default_value_t = args::ShapeArg::Plane)]
+    pub shape: args::ShapeArg,
+    /// Also compile and time both pipelines on the GPU adapter (view 60°, distance 6). On a software
+    /// adapter (llvmpipe) the all-features pipeline takes many minutes to compile.
+    #[arg(long)]
+    pub time: bool,
+    /// Image size for --time, WxH.
+    #[arg(long, default_value = "256x192", value_parser = args::parse_size)]
+    pub size: (u32, u32),
+    /// Timed batches of 8 frames per mode for --time (1 to 1000).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub frames: u32,
+}
+
+/// Inspect the preset and print what it needs (or JSON).
+pub fn run(args: InspectArgs, ctx: &Context) -> Result<()> {
+    let view = View {
+        view_deg: 60.0,
+        view_azimuth_deg: 0.0,
+        light_deg: args.light_deg,
+        light_azimuth_deg: args.light_azimuth_deg,
+        distance: 6.0,
+        shape: args.shape.shape(2.0).map_err(anyhow::Error::msg)?,
+        march: lodestone_core::scene::march::March::default(),
+        error_block: 8,
+        retry_cut_rays: false,
+    };
+    let opts = Options {
+        view,
+        time: args.time,
+        size: args.size,
+        frames: args.frames,
+    };
+    let i = inspect(&ctx.preset, opts)?;
+    if args.json {
+        outln!("{}", serde_json::to_string_pretty(&i.to_json())?);
+    } else {
+        out!("{}", i.to_text());
+    }
+    Ok(())
+}
 
 /// Options of `lodestone inspect`.
 #[derive(Clone, Copy, Debug)]

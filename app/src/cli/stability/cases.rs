@@ -1,77 +1,21 @@
 //! Stiff and extreme inputs run through core's f64 functions and their f32 mirrors, each against a
 //! reference computed independently (quadrature, an exact limit or identity), for
-//! `lodestone stability` ([`crate::stability`] adds the WGSL path, which needs a GPU adapter).
+//! `lodestone stability` ([`crate::cli::stability`] adds the WGSL path, which needs a GPU adapter).
 //!
 //! A [`Row`] passes when no output is non-finite (or negative where the quantity cannot be) and the
 //! largest deviation stays within the row's documented bound. Deviations are relative with an absolute
 //! floor, `|got − ref| / max(|ref|, floor)`, so values that underflow (erfc(30) ≈ 2e-393) compare as 0.
 
-use crate::stability_materials::{angles, step_map, vertical_curve};
+use crate::cli::stability::inputs::{step_map, vertical_curve};
+use crate::cli::stability::materials::angles;
+use crate::cli::stability::row::{Path, Row, deviation};
 use lodestone_core::math::preconvolved::TableSpec;
 use lodestone_core::math::quadrature::integrate;
 use lodestone_core::math::{special, special_f32};
 use lodestone_core::microfacet::effective_height::{EffectiveHeightTable, exact_moments};
 use lodestone_core::microfacet::transfer::TransferFunction;
 use lodestone_core::scene::direction::direction;
-use serde::Serialize;
 use std::f64::consts::{FRAC_PI_2, PI};
-
-/// Which implementation a row measured.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-pub enum Path {
-    /// lodestone-core, f64.
-    CoreF64,
-    /// lodestone-core's f32 mirror of the GPU code (`special_f32`).
-    CoreF32,
-    /// The WGSL on the GPU adapter.
-    Wgsl,
-}
-
-impl Path {
-    /// Short name for tables.
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::CoreF64 => "core f64",
-            Self::CoreF32 => "core f32",
-            Self::Wgsl => "wgsl",
-        }
-    }
-}
-
-/// One case through one path.
-#[derive(Clone, Debug, Serialize)]
-pub struct Row {
-    /// What was run.
-    pub case: String,
-    /// Which implementation.
-    pub path: Path,
-    /// Outputs checked.
-    pub outputs: usize,
-    /// Largest deviation from the reference (see the module docs; 0 when the case has no reference).
-    pub max_deviation: f64,
-    /// The documented bound on `max_deviation`.
-    pub bound: f64,
-    /// Outputs that were NaN, infinite, or negative where they cannot be.
-    pub non_finite: usize,
-    /// The reference and the deviation's unit.
-    pub reference: String,
-}
-
-impl Row {
-    /// Whether the row is within its bound and all outputs are finite.
-    pub fn passed(&self) -> bool {
-        self.non_finite == 0 && self.max_deviation <= self.bound
-    }
-}
-
-/// `|got − reference| / max(|reference|, floor)`; infinite when `got` is not finite and the
-/// reference is.
-pub fn deviation(got: f64, reference: f64, floor: f64) -> f64 {
-    if !got.is_finite() {
-        return if got == reference { 0.0 } else { f64::INFINITY };
-    }
-    (got - reference).abs() / reference.abs().max(floor)
-}
 
 /// The special functions mirrored in f32 and WGSL (closed set; [`SpecialFunction::name`] is the
 /// function's name in core, its f32 mirror and the WGSL alike).
@@ -496,7 +440,7 @@ pub fn table_rows() -> Vec<Row> {
 pub fn cpu_rows() -> Vec<Row> {
     let mut rows = special_rows();
     rows.extend(table_rows());
-    rows.extend(crate::stability_materials::material_rows());
+    rows.extend(crate::cli::stability::materials::material_rows());
     rows
 }
 

@@ -1,4 +1,4 @@
-//! `lodestone object` (#19): a whole object (sphere, torus or an OBJ mesh) displaced by the
+//! Whole objects (`lodestone object` and the editor's Object window): a whole object (sphere, torus or an OBJ mesh) displaced by the
 //! preset's relief, voxelised into the sparse octree and cone traced on the CPU (core's reference),
 //! and with `--gpu` in WGSL on the adapter, beside its ray-traced ground truth, over a zoom sweep.
 //! For each distance: a PNG strip (nearest voxels | alpha blended | masks, HN12 | ground truth |
@@ -7,8 +7,10 @@
 //! and `object.json` (every number, unrounded, with the octree's memory per level). Bad shapes,
 //! meshes and materials are usage errors (exit code 2).
 
+pub mod scene;
+
 use crate::UsageError;
-use crate::object_scene::{GpuObject, ObjectScene, masks_shot};
+use crate::object::scene::{GpuObject, ObjectScene, masks_shot};
 use anyhow::{Context, Result};
 use lodestone_core::material::Material;
 use lodestone_core::material::colormap::linear_to_srgb;
@@ -64,62 +66,6 @@ pub struct Options {
     pub truth_se: f64,
     /// The most truth rays a pixel may get when refining.
     pub max_rays: usize,
-}
-
-impl Options {
-    /// The options of a parsed `lodestone object` command (its mesh read and checked); an error
-    /// for any other command.
-    pub fn from_command(cmd: crate::cli::Command) -> Result<Self> {
-        let crate::cli::Command::Object {
-            shape,
-            mesh,
-            radius,
-            minor,
-            depth,
-            size,
-            distances,
-            view_deg,
-            view_azimuth_deg,
-            light_deg,
-            light_azimuth_deg,
-            rays,
-            out,
-            no_shadows,
-            gpu,
-            lens,
-            focus,
-            truth_se,
-            max_rays,
-        } = cmd
-        else {
-            anyhow::bail!("not the object command");
-        };
-        Ok(Self {
-            shadows: !no_shadows,
-            gpu,
-            lens,
-            focus,
-            truth_se: truth_se / 100.0,
-            max_rays: max_rays as usize,
-            shape: self::shape(shape.name(), mesh.as_deref(), radius, minor)?,
-            depth,
-            size,
-            distances,
-            view: (view_deg, view_azimuth_deg),
-            light: (light_deg, light_azimuth_deg),
-            rays: rays as usize,
-            out,
-        })
-    }
-
-    /// `lodestone object`'s defaults (the unit sphere, depth 7, 160 × 120, distances 8, 4, 2,
-    /// camera 60°/30°, sun 37°/−37°, 64 rays refined to 0.5%, shadows, CPU only, no strips):
-    /// what the command parses with no options.
-    pub fn sphere_defaults() -> Result<Self> {
-        use clap::Parser;
-        let cli = crate::cli::Cli::try_parse_from(["lodestone", "object"])?;
-        Self::from_command(cli.command.context("no command")?)
-    }
 }
 
 /// The base shape named on the command line; a mesh is read and checked here.
@@ -354,49 +300,4 @@ fn strip(images: &ObjectImages) -> image::RgbImage {
         }
     }
     img
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::cli::{Cli, Command};
-    use clap::Parser;
-
-    /// [`Options::sphere_defaults`] is what `lodestone object` parses with no options (the report's
-    /// object section relies on it), so the two cannot drift apart.
-    #[test]
-    fn the_sphere_defaults_are_the_commands() {
-        let Some(Command::Object {
-            depth,
-            size,
-            distances,
-            view_deg,
-            view_azimuth_deg,
-            light_deg,
-            light_azimuth_deg,
-            rays,
-            no_shadows,
-            gpu,
-            lens,
-            focus,
-            truth_se,
-            max_rays,
-            radius,
-            ..
-        }) = Cli::parse_from(["lodestone", "object"]).command
-        else {
-            panic!("not the object command");
-        };
-        let d = Options::sphere_defaults().unwrap();
-        assert_eq!(d.shape, BaseShape::Sphere { radius });
-        assert_eq!((d.depth, d.size, d.distances), (depth, size, distances));
-        assert_eq!(d.view, (view_deg, view_azimuth_deg));
-        assert_eq!(d.light, (light_deg, light_azimuth_deg));
-        assert_eq!((d.rays, d.max_rays), (rays as usize, max_rays as usize));
-        assert_eq!(
-            (d.shadows, d.gpu, d.lens, d.focus),
-            (!no_shadows, gpu, lens, focus)
-        );
-        assert_eq!(d.truth_se, truth_se / 100.0);
-    }
 }

@@ -1,8 +1,12 @@
 //! `lodestone render` and `lodestone bench`: headless GPU work.
 
-use crate::cli::{Formats, RenderMode};
+use crate::UsageError;
+use crate::cli::Context;
+use crate::cli::args;
+use crate::cli::args::{Formats, RenderMode};
+use crate::cli::check_output;
 use crate::preset_io::Resolved;
-use anyhow::{Context, Result, bail};
+use anyhow::{Context as _, Result, bail};
 use lodestone_core::scene::camera::Camera;
 use lodestone_core::scene::direction::direction;
 use lodestone_core::scene::march::March;
@@ -14,8 +18,88 @@ use lodestone_render::truth_noise::{BlockErrors, SampleMoments, TruthEstimate};
 use lodestone_render::{
     GpuContext, GpuMaterial, LinearImage, Renderer, Scene, ViewMode, ViewTarget,
 };
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
+
+/// The arguments of `lodestone render`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct RenderArgs {
+    /// naive, view-independent, filtered, truth, error (filtered against truth) or all.
+    #[arg(long, value_enum, default_value_t = args::RenderMode::All)]
+    pub mode: args::RenderMode,
+    /// Camera angle from the normal, degrees (0 to 89.5).
+    #[arg(long, default_value_t = 60.0, value_parser = args::view_angle)]
+    pub view_deg: f64,
+    /// Camera azimuth, degrees.
+    #[arg(long, default_value_t = 0.0, value_parser = args::azimuth)]
+    pub view_azimuth_deg: f64,
+    /// Light angle from the normal, degrees (0 to 180; past 90 the sun is below the horizon).
+    #[arg(long, default_value_t = 30.0, value_parser = args::light_angle)]
+    pub light_deg: f64,
+    /// Light azimuth, degrees.
+    #[arg(long, default_value_t = 90.0, value_parser = args::azimuth)]
+    pub light_azimuth_deg: f64,
+    /// Camera distance to its target (world units, 0.02 to 5000, as in the editor); features
+    /// are about 1 unit across.
+    #[arg(long, default_value_t = 6.0, value_parser = args::distance)]
+    pub distance: f64,
+    /// Image size, WxH.
+    #[arg(long, default_value = "512x384", value_parser = args::parse_size)]
+    pub size: (u32, u32),
+    /// The object: the plane, or a cylinder whose top line passes through the camera target.
+    #[arg(long, value_enum, default_value_t = args::ShapeArg::Plane)]
+    pub shape: args::ShapeArg,
+    /// Radius of the cylinder (world units, 0.01 to 10⁴).
+    #[arg(long, default_value_t = 2.0, value_parser = args::radius)]
+    pub radius: f64,
+    /// Ground-truth rays per pixel (1 to 65536).
+    #[arg(long, default_value_t = 64, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    pub spp: u32,
+    /// Output: a .png or .exr file, or a directory for `--mode all`.
+    #[arg(long)]
+    pub out: PathBuf,
+    /// args::Formats written by `--mode all`.
+    #[arg(long, value_enum, default_value_t = args::Formats::Both)]
+    pub formats: args::Formats,
+    /// How the ray marches step and refine a crossing (the reference stays selectable).
+    #[arg(long, value_enum, default_value_t = args::MarchArg::Fast)]
+    pub march: args::MarchArg,
+    /// Side of the pixel blocks on whose means errors are also measured against the truth
+    /// with its own Monte Carlo noise taken out (`error` and `all`; 1 = per pixel).
+    #[arg(long, default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub error_block: u32,
+    /// Trace again, alone, the ground-truth rays whose loops a software adapter (llvmpipe)
+    /// cut short, so they get the march's own answer instead of being counted as unreliable
+    /// (slow near the horizon: those rays skim the relief for thousands of steps).
+    #[arg(long)]
+    pub retry_cut_rays: bool,
+}
+
+/// Render the views the arguments ask for, after checking where they go.
+pub fn run(args: RenderArgs, ctx: &Context) -> Result<()> {
+    let shape = args.shape.shape(args.radius).map_err(UsageError)?;
+    check_output(&args.out, args.mode == args::RenderMode::All)?;
+    let view = View {
+        view_deg: args.view_deg,
+        view_azimuth_deg: args.view_azimuth_deg,
+        light_deg: args.light_deg,
+        light_azimuth_deg: args.light_azimuth_deg,
+        distance: args.distance,
+        shape,
+        march: args.march.march(),
+        error_block: args.error_block,
+        retry_cut_rays: args.retry_cut_rays,
+    };
+    render(
+        &ctx.preset,
+        view,
+        args.mode,
+        args.size,
+        args.spp,
+        &args.out,
+        args.formats,
+    )
+}
 
 /// Camera and light settings from the command line.
 #[derive(Clone, Copy, Debug)]
@@ -253,7 +337,7 @@ pub fn render(
 }
 
 /// Median of a list of durations in milliseconds.
-fn median(mut v: Vec<f64>) -> f64 {
+pub fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     let n = v.len();
     if n == 0 {
@@ -298,193 +382,4 @@ pub fn frame_ms_interleaved(
         }
     }
     times.into_iter().map(median).collect()
-}
-
-/// What `lodestone bench` sweeps.
-#[derive(Clone, Debug)]
-pub struct BenchSweep {
-    /// Camera angles from the normal (degrees).
-    pub view_deg: Vec<f64>,
-    /// Camera distances (world units).
-    pub distance: Vec<f64>,
-    /// Image size.
-    pub size: (u32, u32),
-    /// Timed batches per mode.
-    pub frames: u32,
-    /// The modes to time (names of [`BENCH_MODES`]); the others print NaN.
-    pub modes: Vec<&'static str>,
-    /// Whether to time the reference march too (else its columns print NaN).
-    pub reference: bool,
-    /// Whether the analytic views' rays can stop on crests.
-    pub interception: lodestone_core::eval::interception::Interception,
-}
-
-/// The modes a bench row times, with their JSON names.
-const BENCH_MODES: [(&str, ViewMode); 4] = [
-    ("naive", ViewMode::Naive),
-    ("view_independent", ViewMode::ViewIndependent),
-    ("filtered", ViewMode::Filtered),
-    ("truth", ViewMode::Truth),
-];
-
-/// One configuration's timings (ms per frame).
-#[derive(Clone, Debug)]
-pub struct BenchRow {
-    /// The preset.
-    pub preset: String,
-    /// Camera angle from the normal (degrees).
-    pub view_deg: f64,
-    /// Camera distance.
-    pub distance: f64,
-    /// The same camera and colour with σ_h = 0 (no relief: a textured plane), naive mode.
-    pub flat_ms: f64,
-    /// Each mode's frame (truth: one ray per pixel), fast march.
-    pub frame_ms: std::collections::BTreeMap<String, f64>,
-    /// The same with the reference march.
-    pub reference_ms: std::collections::BTreeMap<String, f64>,
-}
-
-impl BenchRow {
-    fn ms(&self, mode: &str) -> f64 {
-        self.frame_ms.get(mode).copied().unwrap_or(f64::NAN)
-    }
-
-    fn reference(&self, mode: &str) -> f64 {
-        self.reference_ms.get(mode).copied().unwrap_or(f64::NAN)
-    }
-}
-
-/// `lodestone bench`: every preset × view angle × distance, each mode's frame time with the fast
-/// and the reference march, and the flat reference's, light 30° at azimuth 90°.
-pub fn bench(presets: &[(String, Resolved)], cfg: &BenchSweep, json: bool) -> Result<()> {
-    let r = renderer()?;
-    let (w, h) = cfg.size;
-    let mut target = ViewTarget::new(&r, w, h)?;
-    let mut rows = vec![];
-    for (name, preset) in presets {
-        let mut prepared = preset.prepare()?;
-        prepared.interception = cfg.interception;
-        let mut reference = prepared.clone();
-        reference.surface.march = March::Reference;
-        let mut flat_material = preset.clone();
-        flat_material.material.heights.sigma_h = 0.0;
-        let flat = flat_material.prepare()?;
-        for &distance in &cfg.distance {
-            for &view_deg in &cfg.view_deg {
-                let scene = View::measurement(view_deg, distance).scene();
-                let gm = GpuMaterial::new(r.context(), &prepared, scene.camera.target)?;
-                let gref = GpuMaterial::new(r.context(), &reference, scene.camera.target)?;
-                let gflat = GpuMaterial::new(r.context(), &flat, scene.camera.target)?;
-                // Every case's batches interleaved: flat, then each mode with the fast and the
-                // reference march.
-                let chosen: Vec<_> = BENCH_MODES
-                    .iter()
-                    .filter(|(n, _)| cfg.modes.contains(n))
-                    .collect();
-                let marches: &[&GpuMaterial] = if cfg.reference { &[&gm, &gref] } else { &[&gm] };
-                let mut cases = vec![(&gflat, ViewMode::Naive)];
-                for g in marches {
-                    cases.extend(chosen.iter().map(|(_, mode)| (*g, *mode)));
-                }
-                let ms = frame_ms_interleaved(&r, &mut target, &cases, &scene, cfg.frames);
-                let flat_ms = ms[0];
-                let named = |part: &[f64]| {
-                    chosen
-                        .iter()
-                        .zip(part)
-                        .map(|((n, _), t)| ((*n).to_owned(), *t))
-                        .collect()
-                };
-                let frame_ms = named(&ms[1..=chosen.len()]);
-                let reference_ms = named(ms.get(1 + chosen.len()..).unwrap_or_default());
-                rows.push(BenchRow {
-                    preset: name.clone(),
-                    view_deg,
-                    distance,
-                    flat_ms,
-                    frame_ms,
-                    reference_ms,
-                });
-            }
-        }
-    }
-    let adapter = r.context().describe();
-    let pixels = f64::from(w) * f64::from(h);
-    if json {
-        let v = serde_json::json!({
-            "adapter": adapter,
-            "size": [w, h],
-            "frames": cfg.frames,
-            "timing": "synchronised wall time per frame: median over batches of 8 back-to-back frames, the cases of a row interleaved batch by batch",
-            "flat": "the same camera and colour table with sigma_h = 0 (a textured plane), naive mode",
-            "rows": rows.iter().map(|row| serde_json::json!({
-                "preset": row.preset,
-                "view_deg": row.view_deg,
-                "distance": row.distance,
-                "flat_ms": row.flat_ms,
-                "frame_ms": row.frame_ms,
-                "over_flat": BENCH_MODES.iter().map(|(n, _)| ((*n).to_owned(), serde_json::json!(row.ms(n) / row.flat_ms))).collect::<serde_json::Map<_, _>>(),
-                "reference_march_ms": row.reference_ms,
-                "over_reference_march": BENCH_MODES.iter().map(|(n, _)| ((*n).to_owned(), serde_json::json!(row.ms(n) / row.reference(n)))).collect::<serde_json::Map<_, _>>(),
-                "filtered_over_naive": row.ms("filtered") / row.ms("naive"),
-                "truth_ns_per_ray": row.ms("truth") * 1e6 / pixels,
-            })).collect::<Vec<_>>(),
-        });
-        outln!("{}", serde_json::to_string_pretty(&v)?);
-    } else {
-        outln!(
-            "{adapter}, {w}×{h}, median over {} batches of 8 frames (synchronised wall time, all cases of a row interleaved batch by batch); \
-             ×flat = frame time over the same view with σ_h = 0; /ref = fast march over the reference march",
-            cfg.frames
-        );
-        outln!(
-            "{:<28} {:>5} {:>6} {:>9} {:>9} {:>6} {:>9} {:>9} {:>6} {:>6} {:>9} {:>6} {:>6} {:>9} {:>6}",
-            "preset",
-            "view",
-            "dist",
-            "flat ms",
-            "naive ms",
-            "×flat",
-            "v-ind ms",
-            "filt ms",
-            "×flat",
-            "/ref",
-            "truth ms",
-            "×flat",
-            "/ref",
-            "ns/ray",
-            "f/n"
-        );
-        for row in &rows {
-            let (f, n, v, fi, t) = (
-                row.flat_ms,
-                row.ms("naive"),
-                row.ms("view_independent"),
-                row.ms("filtered"),
-                row.ms("truth"),
-            );
-            outln!(
-                "{:<28} {:>5.1} {:>6.2} {f:>9.2} {n:>9.2} {:>6.2} {v:>9.2} {fi:>9.2} {:>6.2} {:>6.2} {t:>9.2} {:>6.2} {:>6.2} {:>9.1} {:>6.2}",
-                short_name(&row.preset),
-                row.view_deg,
-                row.distance,
-                n / f,
-                fi / f,
-                fi / row.reference("filtered"),
-                t / f,
-                t / row.reference("truth"),
-                t * 1e6 / pixels,
-                fi / n
-            );
-        }
-    }
-    Ok(())
-}
-
-/// The file name of a preset path (the whole string when it has none), at most 28 characters.
-fn short_name(p: &str) -> String {
-    let name = Path::new(p)
-        .file_name()
-        .map_or_else(|| p.to_owned(), |n| n.to_string_lossy().into_owned());
-    name.chars().take(28).collect()
 }

@@ -11,7 +11,7 @@
 //! comes from the reference's squared sums ([`TruthEstimate`]). Pixels given more than R/2 rays are
 //! capped at R/2 so that every shaded pixel is a prefix.
 
-use crate::chart::{Chart, Series};
+use crate::report::chart::{Chart, Series};
 use lodestone_core::math::correlation::{pearson, spearman};
 use lodestone_render::LinearImage;
 use lodestone_render::truth_noise::TruthEstimate;

@@ -1,0 +1,167 @@
+//! Tests of [`super`].
+
+use super::*;
+use lodestone_core::scene::camera::Camera;
+use lodestone_core::scene::direction::direction;
+use lodestone_core::scene::shape::Shape;
+
+fn request(generation: u64, spp: u32) -> Request {
+    Request {
+        generation,
+        material: Arc::new(Material::default()),
+        image: None,
+        environment: None,
+        measured: None,
+        scene: Scene {
+            camera: Camera::default(),
+            light: direction(0.5, 1.0),
+            shape: Shape::Plane,
+        },
+        size: [32, 24],
+        modes: vec![ViewMode::Naive, ViewMode::Filtered, ViewMode::Truth],
+        truth_spp: spp,
+        max_scale: 1.0,
+        adaptive_truth: false,
+        march: March::Fast,
+    }
+}
+
+/// A headless worker whose device is up, or `None` (logged as skipped as `test`) without an
+/// adapter.
+fn ready_worker(test: &str) -> Option<Worker> {
+    let w = Worker::spawn(DeviceSource::Headless, || {});
+    match w.wait(Duration::from_secs(60)) {
+        Some(Event::Ready { .. }) => Some(w),
+        Some(Event::NoAdapter(e)) => {
+            lodestone_tests::skip(test, e);
+            None
+        }
+        other => panic!("unexpected {other:?}"),
+    }
+}
+
+/// A panic while serving (as a driver's) ends the thread with `Stopped` and its message,
+/// instead of leaving the window waiting; dropping the worker then joins it cleanly.
+#[test]
+fn a_panic_in_the_render_thread_is_reported() {
+    let Some(w) = ready_worker("the worker panic test") else {
+        return;
+    };
+    w.request(request(PANIC_GENERATION, 1));
+    match w.wait(Duration::from_secs(60)) {
+        Some(Event::Stopped(msg)) => assert!(msg.contains("injected"), "{msg}"),
+        other => panic!("unexpected {other:?}"),
+    }
+    drop(w);
+}
+
+/// The worker renders every requested mode, refines to full size, and accumulates exactly
+/// the requested truth samples.
+#[test]
+fn serves_every_mode_up_to_full_resolution() {
+    let Some(w) = ready_worker("the worker test") else {
+        return;
+    };
+    w.request(request(7, 3));
+    let mut full = Vec::new();
+    let mut truth_spp = 0;
+    while let Some(ev) = w.wait(Duration::from_secs(120)) {
+        let Event::Frame(f) = ev else {
+            panic!("unexpected {ev:?}")
+        };
+        assert_eq!(f.generation, 7);
+        assert!(f.image.pixels.iter().flatten().all(|v| v.is_finite()));
+        if f.scale == 1.0 {
+            assert_eq!((f.image.width, f.image.height), (32, 24));
+            full.push(f.mode);
+        }
+        if f.mode == ViewMode::Truth {
+            truth_spp = f.samples;
+            if f.samples == 3 {
+                break;
+            }
+        }
+    }
+    assert!(full.contains(&ViewMode::Naive) && full.contains(&ViewMode::Filtered));
+    assert_eq!(truth_spp, 3);
+}
+
+/// Adaptive ground truth spends the requested rays per pixel on average, gives pixels
+/// different counts, traces exactly those (each pixel's weight is its count), and gives the
+/// pixels the prediction calls noisier more rays.
+#[test]
+fn adaptive_truth_gives_each_pixel_its_planned_rays() {
+    let w = Worker::spawn(DeviceSource::Headless, || {});
+    match w.wait(Duration::from_secs(60)) {
+        Some(Event::Ready { adapter, .. }) => {
+            lodestone_tests::ran("adaptive_truth_gives_each_pixel_its_planned_rays", &adapter)
+        }
+        Some(Event::NoAdapter(e)) => {
+            lodestone_tests::skip("the adaptive worker test", e);
+            return;
+        }
+        other => panic!("unexpected {other:?}"),
+    }
+    let mut req = request(9, 8);
+    req.adaptive_truth = true;
+    req.modes = vec![ViewMode::Truth];
+    // Grazing, the sun low on the far side: glints and shadows make the noise uneven.
+    req.scene.camera.elevation_deg = 75.0;
+    req.scene.camera.distance = 3.0;
+    req.scene.light = direction(1.2, 0.0);
+    w.request(req);
+    let mut last = None;
+    while let Some(ev) = w.wait(Duration::from_secs(300)) {
+        let Event::Frame(f) = ev else {
+            panic!("unexpected {ev:?}")
+        };
+        if f.mode != ViewMode::Truth {
+            continue;
+        }
+        assert!(f.image.pixels.iter().flatten().all(|v| v.is_finite()));
+        let done = f.samples >= 8;
+        last = Some(f);
+        if done {
+            break;
+        }
+    }
+    let f = last.expect("a truth frame");
+    let rays = f.rays.as_deref().expect("an adaptive truth's ray counts");
+    let sd = f.predicted_sd.as_deref().expect("its prediction");
+    let n = 32 * 24;
+    assert_eq!((rays.len(), sd.len()), (n, n));
+    // The predicted bandwidth came with it: the sky 0, the horizon Nyquist's, the rest between.
+    let b = f.predicted_bandwidth.as_deref().expect("its bandwidth");
+    assert_eq!(b.len(), n);
+    assert!(b.iter().all(|v| (0.0..=0.5).contains(v)), "{b:?}");
+    assert!(b.contains(&0.0) && b.contains(&0.5) && b.iter().any(|v| *v > 0.0 && *v < 0.5));
+    let total: u32 = rays.iter().sum();
+    assert!(total.abs_diff(8 * n as u32) <= 1, "{total} rays");
+    // Traced as planned: each pixel's weight is its ray count.
+    for (p, r) in f.image.pixels.iter().zip(rays) {
+        assert_eq!(p[3], *r as f32);
+    }
+    let (lo, hi) = (rays.iter().min().unwrap(), rays.iter().max().unwrap());
+    assert!(*lo >= 1 && hi > lo, "rays {lo}..{hi}");
+    // Noisier predicted pixels got more rays on average.
+    let cost = f.cost.as_deref().expect("its costs");
+    assert!(cost.iter().all(|c| *c >= 1.0));
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|a, b| sd[*a].total_cmp(&sd[*b]));
+    let mean = |ix: &[usize]| ix.iter().map(|&p| f64::from(rays[p])).sum::<f64>() / ix.len() as f64;
+    let (quiet, noisy) = (mean(&order[..n / 4]), mean(&order[3 * n / 4..]));
+    eprintln!("rays {lo}..{hi}: quietest quarter {quiet}, noisiest {noisy}");
+    assert!(
+        noisy > 1.5 * quiet,
+        "rays: quietest quarter {quiet}, noisiest {noisy}"
+    );
+}
+
+#[test]
+fn reports_a_missing_adapter() {
+    let w = Worker::spawn(DeviceSource::Unavailable, || {});
+    assert!(matches!(
+        w.wait(Duration::from_secs(10)),
+        Some(Event::NoAdapter(_))
+    ));
+}
