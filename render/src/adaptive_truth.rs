@@ -332,7 +332,7 @@ pub struct Progressive<'a> {
 /// go on. Returns the rays per pixel traced.
 ///
 /// Unlike [`render_adaptive`]'s two passes, every pixel is shaded (no lattice: on noise-limited
-/// images interpolation lost, docs/design.md), and the plan learns from each round, so a pixel
+/// images interpolation lost, docs/design/adaptive-truth.md), and the plan learns from each round, so a pixel
 /// whose noise the model missed catches up at the next.
 pub fn render_progressive(
     renderer: &Renderer,

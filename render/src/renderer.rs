@@ -64,7 +64,7 @@ impl Renderer {
     /// gets the march's own answer (all but those that need more than 65535 iterations of one
     /// loop even alone, which stay counted). Off by default: the rays cut are the ones that skim
     /// the surface near the horizon for thousands of steps, and tracing them alone cost 50× the
-    /// frame at 80° (docs/design.md). Ignored on other adapters, which cut nothing.
+    /// frame at 80° (docs/design/software-adapter.md). Ignored on other adapters, which cut nothing.
     pub fn set_retry_cut(&mut self, on: bool) {
         self.retry_cut = on;
     }

@@ -761,7 +761,7 @@ fn truth_moments_are_the_sums_of_squared_rays() {
 /// call or two, holds exactly the sums of `draw`'s first n rays there (its own low-discrepancy
 /// sequence), and a pixel with no ray reads 0. This camera sees no horizon: on llvmpipe a long
 /// march's result can depend on the rays sharing its SIMD batch (Mesa's gallivm cuts any loop of a
-/// shader after 65535 iterations over the batch; docs/design.md), and the two paths batch rays
+/// shader after 65535 iterations over the batch; docs/design/software-adapter.md), and the two paths batch rays
 /// differently. [`cut_rays_traced_again_alone_agree_across_paths`] covers the horizon.
 #[test]
 fn planned_truth_gives_each_pixel_its_own_first_rays() {

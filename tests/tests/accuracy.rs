@@ -20,7 +20,7 @@ const RAYS: usize = 20_000;
 const VIEWS: [f64; 3] = [0.0, 60.0, 85.0];
 
 /// Lights: (angle from the normal, azimuth; the view's azimuth is 0), degrees. The 60° lights are
-/// where the transfer curves miss (docs/design.md, "Transfer curves: masking that knows the
+/// where the transfer curves miss (docs/design/transfer-curves.md, "Masking that knows the
 /// driver's slope").
 const LIGHTS: [(f64, f64); 5] = [
     (0.0, 0.0),
@@ -35,12 +35,12 @@ const LIGHTS: [(f64, f64); 5] = [
 /// specular (+69% of itself, 12% of the light) of the value-conditioned slope mixture, not
 /// diagnosed further (its four other entries, 1.3–17%
 /// with one slope Gaussian, met the goal once the slopes were conditioned on the image's value,
-/// docs/design.md). (Snow under sky at 85°, 5–6% beyond the truth's noise with Smith's masking,
+/// docs/design/slope-masking.md). (Snow under sky at 85°, 5–6% beyond the truth's noise with Smith's masking,
 /// met the goal once the masking was conditioned on height and slope jointly: 1.4–1.5%. Terraces, 1.3–1.6% at 0° and
 /// 60° with the transfer mixture's 8 bins, met the goal once the mixture had 16: 0.6–0.9%.)
 ///
 /// With the light at 60° (measured 2026-12-05, ×1.1): the transfer curves' bins now take the
-/// masking conditioned on the driver's value and slope (docs/design.md, "Transfer curves: masking
+/// masking conditioned on the driver's value and slope (docs/design/transfer-curves.md, "Masking
 /// that knows the driver's slope"), which met the goal on terraces at 85° and on sponge at 60°
 /// and 85° with the light along the view (Smith's bins were up to 12.8% beyond the truth's
 /// noise there). Left: terraces at 60° with the light 60° opposite (1.8% beyond; Smith's 4.8%),

@@ -76,7 +76,7 @@ fn value_conditioned_slopes_put_cobblestones_near_the_truth() {
 /// of itself): the explicit surface sampled on a 400² grid of the tile, split into 8 bins of equal
 /// probability of the value, each bin's specular lobe without masking against the Gaussian of
 /// that bin's own slopes ([`filtered_specular`]), and the visibility along the view of the facets
-/// under the lobe (lobe-weighted) against the bin's average facet. Measurement (docs/design.md,
+/// under the lobe (lobe-weighted) against the bin's average facet. Measurement (docs/design/image-drivers.md,
 /// "Cobblestones at 85°: the grooves' far walls"): `cargo test --release -p lodestone-tests --test
 /// image_slopes -- --ignored --nocapture grazing_specular_by_value`.
 #[test]

@@ -5,7 +5,7 @@
 //! a few rays a pixel would bury it). The far-patch grid (`accuracy.rs`) cannot see this zoom:
 //! where a footprint resolves part of the relief, the march masks the resolved part and the model
 //! the rest, and the unresolved relief stops rays on the crests they pass
-//! ([`lodestone_core::eval::interception`]; docs/design.md, "The views at middle zoom").
+//! ([`lodestone_core::eval::interception`]; docs/design/accuracy.md, "The views at middle zoom").
 //!
 //! As in `accuracy.rs`, the error that counts is beyond 3 standard errors of the truth, worst
 //! channel, against #17's goal (1% up to 60°, 4% beyond); [`KNOWN`] holds the measured shortfalls
@@ -164,7 +164,7 @@ fn middle_zoom_meets_the_accuracy_goal_or_its_known_bound() {
     assert!(failures.is_empty(), "{}", failures.join(",\n"));
 }
 
-/// The sweep behind the test (docs/design.md, "The views at middle zoom"): per preset and
+/// The sweep behind the test (docs/design/accuracy.md, "The views at middle zoom"): per preset and
 /// configuration, five zooms from a resolved driver to the far field, the material's own masking
 /// and Smith's, and the far weight `(σ_f,footprint/σ_f)²` at the image's centre, with which the
 /// transfer curves' conditioned bins blend toward Smith's. `LODESTONE_PRESETS=a.ron,b.ron` and

@@ -311,7 +311,7 @@ impl ObjectPanel {
                     }
                 })
                 .response
-                .on_hover_text("The base shape displaced by the material's relief: F = d_B − σ_h g(f) (design.md, Whole objects)");
+                .on_hover_text("The base shape displaced by the material's relief: F = d_B − σ_h g(f) (docs/design/objects.md, Whole objects)");
             if self.shape == ShapeKind::Mesh {
                 let name = self.mesh.as_ref().and_then(|p| p.file_name()).map_or("choose…".into(), |n| n.to_string_lossy().into_owned());
                 if ui.button(format!("OBJ: {name}")).on_hover_text("A closed, consistently oriented triangle mesh (.obj)").clicked()

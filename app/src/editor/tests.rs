@@ -627,11 +627,20 @@ fn the_baseline_view_switches_in_place() {
 fn every_character_of_the_editor_texts_has_a_glyph() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("src/editor");
     let mut chars = std::collections::BTreeSet::new();
-    for entry in std::fs::read_dir(&dir).expect("src/editor") {
-        let p = entry.expect("entry").path();
-        if p.file_name().is_some_and(|n| n == "tests.rs") {
-            continue;
+    let mut files = vec![];
+    let mut folders = vec![dir];
+    while let Some(folder) = folders.pop() {
+        for entry in std::fs::read_dir(&folder).expect("src/editor") {
+            let p = entry.expect("entry").path();
+            if p.is_dir() {
+                folders.push(p);
+            } else if p.file_name().is_some_and(|n| n != "tests.rs") {
+                files.push(p);
+            }
         }
+    }
+    assert!(files.len() > 20, "found only {} editor files", files.len());
+    for p in files {
         let text = std::fs::read_to_string(&p).expect("source");
         // Characters inside string literals (comment lines skipped).
         for line in text.lines().filter(|l| !l.trim_start().starts_with("//")) {

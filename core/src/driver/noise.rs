@@ -1,5 +1,5 @@
 //! A procedural driver with analytic footprint statistics: a sum of random-phase sinusoids,
-//! `f(x) = Σ a_i cos(2π k_i·x + φ_i)` (docs/design.md, "One noise, three uses").
+//! `f(x) = Σ a_i cos(2π k_i·x + φ_i)` (docs/design/noise.md, "One noise, three uses").
 //!
 //! * Unit variance: `Σ a_i²/2 = 1`, so f is (approximately, by the central limit theorem) N(0, 1),
 //!   the Gaussian driver of [HNPN14 Sec. 4.2].

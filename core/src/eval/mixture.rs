@@ -273,7 +273,7 @@ mod tests {
 
     /// A transfer curve (moss) makes the slopes a scale mixture correlated with the colour: one
     /// Gaussian (the papers' model, `transfer_slopes: Gaussian`) is 6–34% off the ray-traced
-    /// truth up to 60° (core/src/eval/independent.rs), the mixture within 3% up to 30%
+    /// truth up to 60° (core/src/eval/independent_tests.rs), the mixture within 3% up to 30%
     /// (measured: 2.7% at most) with the colour by driver or by height, and so is the binned
     /// mixture the views run; over these configurations the worst errors of either sum to under
     /// a third of the Gaussian's. Far patch, 20k rays.
@@ -361,7 +361,7 @@ mod binning {
             ("terraces", [2.2, 3.2, 6.5]),
         ] {
             // Smith's bins: the fine mixture's masking is Smith's (the conditioned bins are
-            // measured against the truth, transfer_masking_measurements.rs).
+            // measured against the truth, core/tests/measurements/transfer_masking.rs).
             let mut p = Evaluator::new(&preset(name)).expect("prepared");
             p.transfer_masking = None;
             for (deg, light, az) in CONFIGS {

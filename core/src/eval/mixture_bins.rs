@@ -33,7 +33,7 @@
 //! node on #17's grid). Each sub-value's specular lobe is widened by its own slopes and takes the
 //! joint term's mean over its half-vector posterior, in closed form
 //! ([`Evaluator::lobe_visibility`]). The two are blended by the
-//! footprint's far weight (docs/design.md, "Transfer curves: masking that knows the driver's
+//! footprint's far weight (docs/design/transfer-curves.md, "Masking that knows the driver's
 //! slope"). On #17's grid terraces' worst excess is 2.69% (0–60°) and 1.32% (75–85°), where
 //! Smith's bins have 5.06% and 14.46%; sponge 0.24% and 4.52% (Smith's 2.10% and 13.43%).
 

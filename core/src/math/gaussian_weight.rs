@@ -6,7 +6,7 @@
 //! product, and its mean over a specular lobe's half-vector posterior as an expectation.
 //!
 //! A weight is exactly a Gaussian function when `w(z)·N(z; 0, I)` is a Gaussian (the visibility's
-//! reweighting of the driver slopes' Gaussian, docs/design.md); for any other weight
+//! reweighting of the driver slopes' Gaussian, docs/design/transfer-curves.md); for any other weight
 //! [`GaussianWeight::along`] matches its mass and its first two moments.
 
 use glam::{DMat2, DVec2};

@@ -1,5 +1,5 @@
 //! Masking under a transfer curve, conditioned on the start's driver value and slope (#17;
-//! docs/design.md, "Transfer curves: masking that knows the driver's slope").
+//! docs/design/transfer-curves.md, "Masking that knows the driver's slope").
 //!
 //! The surface is `h = σ_h·g(f)` over a Gaussian driver f. Along a horizontal direction d the
 //! driver is a stationary Gaussian process; in units where it has unit variance and unit slope

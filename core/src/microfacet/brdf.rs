@@ -103,7 +103,7 @@ impl BaseBrdf {
 
 /// Specular averaged over D_s, in world slope space with facet slopes `s ~ N(s̄, Σ)` each carrying
 /// the base lobe `N(s_h − s; σ0²I)` (the explicit facets' BRDF, [`crate::microfacet::brdf`]) and weighted by its
-/// projected area `u⁺(s)`, `u(s) = ωo_z − s·ωo_xy` (docs/design.md, "Visible slope distribution"):
+/// projected area `u⁺(s)`, `u(s) = ωo_z − s·ωo_xy` (docs/design/filtered-model.md, "Visible slope distribution"):
 ///
 /// `F0·∫N(s; s̄, Σ)N(s_h − s; σ0²I)u⁺(s)ds / (4 h_z⁴ ωo_z E[u⁺])
 ///  = F0·N(s_h − s̄; Σ + σ0²I)·E_post[u⁺] / (4 h_z⁴ ωo_z E[u⁺])`,

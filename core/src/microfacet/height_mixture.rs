@@ -1,5 +1,5 @@
 //! Slopes under a transfer curve as a mixture of Gaussians over the driver's value, binned the
-//! way a shader can afford (#17; docs/design.md, "Transfer curves").
+//! way a shader can afford (#17; docs/design/transfer-curves.md, "Transfer curves").
 //!
 //! For a Gaussian driver f ~ N(f̄, σ_f²) over the footprint, the value and the gradient of f at a
 //! point are independent, so the transformed surface h = σ_h·g(f) has, given f, Gaussian slopes
@@ -31,7 +31,7 @@ pub enum TransferSlopes {
 }
 
 /// Bins of equal probability before the knots are added: 16 (8 left terraces 1.3–1.6% off the
-/// ray-traced truth at 0° and 60°, 16 brings it to 0.6–0.9%; docs/design.md).
+/// ray-traced truth at 0° and 60°, 16 brings it to 0.6–0.9%; docs/design/transfer-curves.md).
 pub const MIXTURE_BINS: usize = 16;
 
 /// Knots of the curve used as bin edges, at most (inside the footprint's quantile range; when

@@ -7,7 +7,7 @@
 //! covariance `Σ_t = Σ ½ v_i v_iᵀ + σ0² I`. That is right near the mean and wrong in the tails:
 //! the slopes are bounded by `Σ|v_i|`, and a specular half vector 4σ out (bumpy-specular at 75°
 //! with the light at 30° on the same side) sees a density 200× below the Gaussian's (measured on
-//! the explicit surface: `core/src/eval/independent.rs`, `grazing_specular_decomposition`).
+//! the explicit surface: `core/src/eval/independent_tests.rs`, `grazing_specular_decomposition`).
 //!
 //! The cumulant generating function is exact and cheap:
 //! `K(τ) = Σ ln I0(τ·v_i) + ½σ0²|τ|²` ([`log_bessel_i0`]), and the saddlepoint density

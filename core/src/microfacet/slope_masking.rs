@@ -1,4 +1,4 @@
-//! Masking conditioned on the facet's slope (#17; docs/design.md, "The grazing diffuse error is
+//! Masking conditioned on the facet's slope (#17; docs/design/slope-masking.md, "The grazing diffuse error is
 //! slope-conditioned masking").
 //!
 //! Smith's masking makes a facet's visibility depend on its height alone. On a correlated surface it
@@ -19,7 +19,7 @@
 //! the mean visibility stays Smith's, only its share among the pairs moves
 //! ([`crate::eval::masking::slope_weights`]). [`conditioned_masking`], the height-averaged profile
 //! `E_h₀[G1(h₀, t)]`, is what session 18's views used (colour and slopes reweighted separately,
-//! which failed with the light opposite the view; docs/design.md); the measurements keep it.
+//! which failed with the light opposite the view; docs/design/slope-masking.md); the measurements keep it.
 //!
 //! Units: the process is normalised to unit height and slope variance ([`LineProcess`]), so the
 //! slope is `z = t/σ_t` and the ray's slope `ν = μ/σ_t`, with `σ_t = √λ₂` the slope's standard

@@ -56,7 +56,7 @@ impl SlopeCov {
     }
 
     /// Standard deviation of the slope projected on the horizontal unit direction (cos φ, sin φ):
-    /// `σ(φ)² = cos²φ σ_x² + 2 cos φ sin φ c_xy + sin²φ σ_y²` (docs/design.md, "Masking–shadowing").
+    /// `σ(φ)² = cos²φ σ_x² + 2 cos φ sin φ c_xy + sin²φ σ_y²` (docs/design/filtered-model.md, "Masking–shadowing").
     /// Never negative (rounding is clamped at 0).
     pub fn projected_std(&self, cos_phi: f64, sin_phi: f64) -> f64 {
         let v = cos_phi * cos_phi * self.xx

@@ -119,7 +119,7 @@ pub fn visible_cosine_rule() -> &'static (Vec<f64>, Vec<f64>) {
 /// `E[(n·ωo)⁺(n·ωi)⁺/n_z] / E[(n·ωo)⁺/n_z]` on a 4 × 4 Gauss–Hermite product rule. HN12 take
 /// `(l·n̄)⁺` (Eq. 13), first order in the facets' tilt: where a voxel holds whole bumps (slope
 /// std ≈ 0.35) that read the sphere seen from afar 3% bright against the ray-traced truth; this
-/// mean took it to within 2% at every distance (docs/design.md, "What is left where a voxel holds
+/// mean took it to within 2% at every distance (docs/design/objects.md, "What is left where a voxel holds
 /// whole bumps"). Masking is Smith's elsewhere (uncorrelated with the slope). A zero covariance gives
 /// `ωi_z`; so does a rule whose facets all face away (never NaN).
 pub fn visible_cosine(cov: &crate::microfacet::slopes::SlopeCov, wo: DVec3, wi: DVec3) -> f64 {

@@ -23,7 +23,7 @@
 //!   tips of peaks rising into it has α well below 1, and the cone tracer shows its mean plane on
 //!   that share of a pixel's sub-rays only (`cone_trace.rs`). Without it such a voxel presents its
 //!   whole half-space and the tips, whose colour goes with height, get 1.3–2× their visible area
-//!   (docs/design.md, "Attributed per voxel"). This is our addition: HN12 store no occupancy beyond
+//!   (docs/design/objects.md, "Attributed per voxel"). This is our addition: HN12 store no occupancy beyond
 //!   the distance field.
 //!
 //! Edge cases: an empty voxel (no area) has no descriptor; normals that cancel (`|E[n]| < 1e-9`, a

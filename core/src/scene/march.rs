@@ -2,7 +2,7 @@
 //! ([`march_heightfield`], [`sphere_trace`]), the refinement of a bracketed crossing ([`refine`]),
 //! and the choice between the reference and the fast march ([`March`]).
 //!
-//! Step rule (sphere tracing for heightfields, docs/design.md): along a ray `p(t) = o + t·d`, the gap
+//! Step rule (sphere tracing for heightfields, docs/design/marches.md): along a ray `p(t) = o + t·d`, the gap
 //! `z(t) − h(x(t))` changes at most at rate `|d_z| + K_d |d_xy|`, where `K_d` bounds the slope of h
 //! along the ray's horizontal direction ([`crate::scene::surface::Surface::lipschitz_along`]). So the
 //! step `Δt = gap/(|d_z| + K_d|d_xy|)` can never cross the surface. To bound the work where a ray

@@ -1,7 +1,7 @@
 //! Measurements behind #17's slope-conditioned masking (all `#[ignore]`d: they print tables; run
 //! with `cargo test --release -p lodestone-core --test measurements -- --ignored --nocapture NAME`): how much of the
 //! grazing diffuse error a height-only visibility leaves, and a prototype of masking conditioned on
-//! the facet's slope (docs/design.md, "The grazing diffuse error is slope-conditioned masking").
+//! the facet's slope (docs/design/slope-masking.md, "The grazing diffuse error is slope-conditioned masking").
 
 use crate::evaluation::{FrontPoint, front_point, worst_error};
 use glam::{DVec2, DVec3};

@@ -1,6 +1,6 @@
 //! Measurements of the filtered view's slope-conditioned masking (#17) against the ground truth,
 //! and of the slope dependence of shadowing (all `#[ignore]`d: they print tables; run with
-//! `cargo test --release -p lodestone-core --test measurements -- --ignored --nocapture NAME`; docs/design.md, "In the
+//! `cargo test --release -p lodestone-core --test measurements -- --ignored --nocapture NAME`; docs/design/slope-masking.md, "In the
 //! filtered view").
 
 use crate::evaluation::{FrontPoint, front_point, worst_error};

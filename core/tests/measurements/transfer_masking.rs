@@ -1,7 +1,7 @@
 //! Measurements behind #17's transfer-curve masking (`#[ignore]`d: they print tables; run with
 //! `cargo test --release -p lodestone-core -- --ignored --nocapture transfer_conditioned`): what
 //! a visibility that knows the point's driver value alone leaves, against one that also knows the
-//! driver's slope along the view's azimuth (docs/design.md, "Transfer curves").
+//! driver's slope along the view's azimuth (docs/design/transfer-curves.md, "Transfer curves").
 
 use crate::evaluation::traced_point;
 use lodestone_core::eval::{Evaluator, FootprintQuery};

@@ -32,7 +32,7 @@ impl State {
             predicted: &predicted,
             rays_per_pixel: f64::from(spp),
             max_rays: spp.saturating_mul(MAX_RAYS_FACTOR).max(16),
-            // Measured in `lodestone report` (docs/design.md): on llvmpipe the cost-aware plan
+            // Measured in `lodestone report` (docs/design/adaptive-truth.md): on llvmpipe the cost-aware plan
             // lost to the plain one at equal error in time as well as in rays.
             cost_aware: false,
         };

@@ -7,7 +7,7 @@
 //! opposite the view: +8% to +10% against Smith's +3% to +5% on a Gaussian material at 75°–85°
 //! with the light 46° from the normal (masking alone: −1.5% to −5%). Among the facets the eye
 //! sees (the high ones) the shadowing depends on the slope far less than the marginal profile
-//! says, and the product of two height-averaged profiles cannot know that (docs/design.md).
+//! says, and the product of two height-averaged profiles cannot know that (docs/design/slope-masking.md).
 
 use crate::driver::footprint::Footprint;
 use crate::eval::Evaluator;
@@ -485,7 +485,7 @@ mod tests {
     }
 
     /// The grazing errors of #17 that slope-conditioned masking closes, against the ground truth's
-    /// far patch (docs/design.md, "The grazing diffuse error is slope-conditioned masking"): Smith's
+    /// far patch (docs/design/slope-masking.md, "The grazing diffuse error is slope-conditioned masking"): Smith's
     /// masking leaves 4–9%, the conditioned one within 2.5% plus two standard errors.
     #[test]
     fn conditioned_masking_closes_the_grazing_errors() {

@@ -15,7 +15,7 @@
 //! The bins read the entries' Gaussian moments ([`crate::eval::masking::transfer_moments`], built with the
 //! table) rather than the entries: [`crate::eval::Evaluator::new`] builds both when the material
 //! asks for conditioned masking under a transfer curve, and the views upload the moments
-//! (docs/design.md, "Transfer curves: masking that knows the driver's slope", has the grid).
+//! (docs/design/transfer-curves.md, "Masking that knows the driver's slope", has the grid).
 
 use crate::driver::noise::SumOfSines;
 use crate::eval::masking::slope_masking_table::{
@@ -36,7 +36,7 @@ use std::sync::{Arc, Mutex};
 /// Driver values of an entry: `−4 + VALUE_STEP·i` (σ units).
 pub const VALUE_NODES: usize = 32;
 /// Step of the value nodes (σ units): 0.5 smeared a tread's masking across the riser next to
-/// it (terraces, 16% off between nodes; docs/design.md).
+/// it (terraces, 16% off between nodes; docs/design/transfer-curves.md).
 pub const VALUE_STEP: f64 = 0.25;
 /// Driver slopes of an entry: `−4 + SLOPE_STEP·j` (σ units).
 pub const SLOPE_NODES: usize = 17;
@@ -290,7 +290,7 @@ pub fn far_weight(footprint_std: f64, global_std: f64) -> f64 {
 /// Points per axis of the Gauss–Hermite rule over the driver's slopes at a value
 /// ([`bin_visibility`]; the rule is their tensor product). 3 left the seen-and-lit share of a
 /// value band up to 0.12 off the per-point model on terraces (G1 falls within 1σ of t over a
-/// tread); 9 is within 0.04–0.07, as a 33 × 33 grid (docs/design.md).
+/// tread); 9 is within 0.04–0.07, as a 33 × 33 grid (docs/design/transfer-curves.md).
 pub const RULE_POINTS: usize = 9;
 
 /// What one ray needs of the table: its entry and the projections of the driver's whitened
@@ -453,7 +453,7 @@ impl TransferRays {
     /// The conditioned visibility of a start at driver value `x` (global σ) over the footprint's
     /// driver slopes, `[G1 along ωo, joint masking–shadowing]`, each a Gaussian function of the
     /// whitened slopes z: a reweighting of the slopes' Gaussian that the bins shade as any
-    /// Gaussian (docs/design.md, "The visibility as a Gaussian reweighting"). The joint term
+    /// Gaussian (docs/design/transfer-curves.md, "The visibility as a Gaussian reweighting"). The joint term
     /// combines the two rays' own weights as [`bin_visibility`] combines their `G1`: the more
     /// masked one (the smaller mass) times the other to the power `k`, multiplied in closed form
     /// (on #17's grid within 0.15% of a 6 × 3 rule over both projections). Where that product has no Gaussian (it rises faster than the

@@ -14,7 +14,7 @@
 //! - a lookup blends moments linearly in every axis (a mixture of valid moment sets stays valid).
 //!
 //! On the GPU this is 48 reads a ray weight with no special function, where the exact form
-//! integrates 16 cells with two `erfcx` each (and Mesa's loop limiter cut it: docs/design.md).
+//! integrates 16 cells with two `erfcx` each (and Mesa's loop limiter cut it: docs/design/transfer-curves.md).
 
 use crate::math::log_linear_moments::log_linear_moments;
 

@@ -12,7 +12,7 @@ fn wave(i: u32) -> vec4<f32> {
 // storage or workgroup array at such an index one lane at a time, in a branchy loop over the eight
 // lanes (gallivm's emit_load_mem); a uniform array at any index is one branch-free gather, and on a
 // GPU it is the constant cache's broadcast. Measured (default preset, 128², one run, 60°/80° ×
-// distances 1.5/6/40): naive 246–347 ms a frame from workgroup memory, see docs/design.md for the
+// distances 1.5/6/40): naive 246–347 ms a frame from workgroup memory, see docs/design/software-adapter.md for the
 // uniform array's. Only view_main's passes bind it; the exported snippet's eval_* functions never
 // reach these loops. GPU only.
 @group(0) @binding(9) var<uniform> wave_table: array<vec4<f32>, 256>;

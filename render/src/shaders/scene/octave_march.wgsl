@@ -344,7 +344,7 @@ fn octave_march(o: vec3<f32>, d: vec3<f32>, lod: bool, sf: f32) -> f32 {
         // After the first evaluation (which decides whether the ray may settle), skip what the
         // grid proves clear: on the explicit surface only. GPU only: on the level-of-detail
         // surface the skips cost more than the steps they save, on llvmpipe and on an H200 alike
-        // (`LODESTONE_NO_GRID` A/B, 2026-12-04: default preset's naive frames 5–30% and filtered
+        // (`lodestone bench --no-bound-grid` A/B, 2026-12-04: default preset's naive frames 5–30% and filtered
         // 3–12% faster without them; dirt-in-crevices and terraces likewise); ground truth is
         // even there, so it keeps them. Core's march may skip: both are rigorous, and a hit moves
         // by at most the settle width.
