@@ -236,6 +236,11 @@ pub fn wgsl_prelude() -> &'static str {
     &PRELUDE
 }
 
+/// Words of the material's data per row of its texture (a power of two; `DATA_ROW` in WGSL).
+pub const DATA_ROW: u32 = 4096;
+
+const _: () = assert!(DATA_ROW.is_power_of_two());
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -277,8 +282,3 @@ mod tests {
         }
     }
 }
-
-/// Words of the material's data per row of its texture (a power of two; `DATA_ROW` in WGSL).
-pub const DATA_ROW: u32 = 4096;
-
-const _: () = assert!(DATA_ROW.is_power_of_two());
