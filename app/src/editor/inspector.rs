@@ -153,7 +153,7 @@ impl Inspector {
                         if sh.far_from_gaussian() && conditioned && !(m.terms.slope.is_some() || m.lighting.environment.is_some()) {
                             ui.label(
                                 "Far from Gaussian: the filtered view's bins follow the curve and condition their masking \
-                                 on the driver's value and slope [#17]; past 85° from the normal expect a few % \
+                                 on the driver's value and slope; past 85° from the normal expect a few % \
                                  (Filtering, Slope masking: Smith is the faster path).",
                             );
                         } else if sh.far_from_gaussian() {
