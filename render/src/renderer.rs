@@ -28,6 +28,9 @@ pub struct Renderer {
     pipelines: Arc<PipelineCache>,
     /// Threads compiling pipelines ahead of use ([`Renderer::prewarm`]); joined on drop.
     prewarming: Mutex<Vec<std::thread::JoinHandle<()>>>,
+    /// Pipelines [`Renderer::prewarm`] asked for on a device one thread must own (OpenGL), for
+    /// the render thread to compile when it is idle ([`Renderer::compile_deferred`]).
+    deferred: Mutex<Vec<FeatureSet>>,
     /// Ground-truth rays whose loops a software adapter cut are traced again alone
     /// ([`Renderer::set_retry_cut`]).
     retry_cut: bool,
@@ -55,6 +58,7 @@ impl Renderer {
             ctx,
             pipelines: Arc::default(),
             prewarming: Mutex::new(Vec::new()),
+            deferred: Mutex::new(Vec::new()),
             retry_cut: false,
         }
     }
@@ -82,13 +86,33 @@ impl Renderer {
         self.pipelines.ready(features)
     }
 
-    /// Compile the pipelines for `sets` on a background thread (those not cached yet), so that a
-    /// later [`Renderer::draw`] needing one does not wait. Finished threads are reaped here.
+    /// Whether the device must be used from one thread at a time: wgpu's OpenGL backend holds
+    /// one context lock per device and gives up (panics) after about a second of waiting, and a
+    /// pipeline of a large shader takes llvmpipe longer than that to compile, so on OpenGL no
+    /// compile may run beside a frame. Vulkan, Metal and DX12 compile on any thread.
+    pub fn single_threaded(&self) -> bool {
+        self.ctx.info.backend == wgpu::Backend::Gl
+    }
+
+    /// Compile the pipelines for `sets` ahead of use (those not cached yet), so that a later
+    /// [`Renderer::draw`] needing one does not wait: on a background thread where the backend
+    /// allows it (finished threads are reaped here); on a [`single_threaded`](Self::single_threaded)
+    /// device they are queued instead, for the thread that renders to compile between frames
+    /// with [`Renderer::compile_deferred`] (a draw that needs one first compiles it itself).
     pub fn prewarm(&self, sets: Vec<FeatureSet>) {
         let missing: Vec<_> = sets
             .into_iter()
             .filter(|s| !self.pipelines.ready(*s))
             .collect();
+        if self.single_threaded() {
+            let mut deferred = self.deferred.lock().unwrap_or_else(|e| e.into_inner());
+            for s in missing {
+                if !deferred.contains(&s) {
+                    deferred.push(s);
+                }
+            }
+            return;
+        }
         let mut threads = self.prewarming.lock().unwrap_or_else(|e| e.into_inner());
         threads.retain(|t| !t.is_finished());
         if missing.is_empty() {
@@ -106,6 +130,38 @@ impl Renderer {
             Ok(t) => threads.push(t),
             Err(e) => log::warn!("cannot compile pipelines ahead of use: {e}"),
         }
+    }
+
+    /// Compile one pipeline [`Renderer::prewarm`] queued, on the calling thread (the one that
+    /// renders); `false` when none is left. Call it when idle: it takes as long as the compile.
+    pub fn compile_deferred(&self) -> bool {
+        loop {
+            let next = {
+                let mut deferred = self.deferred.lock().unwrap_or_else(|e| e.into_inner());
+                if deferred.is_empty() {
+                    return false;
+                }
+                deferred.remove(0)
+            };
+            if !self.pipelines.ready(next) {
+                self.pipelines.get(&self.ctx.device, next);
+                return true;
+            }
+        }
+    }
+
+    /// How many pipelines [`Renderer::prewarm`] queued for [`Renderer::compile_deferred`].
+    pub fn deferred_count(&self) -> usize {
+        self.deferred
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .len()
+    }
+
+    /// How many threads are compiling pipelines ahead of use now.
+    pub fn compiling_threads(&self) -> usize {
+        let threads = self.prewarming.lock().unwrap_or_else(|e| e.into_inner());
+        threads.iter().filter(|t| !t.is_finished()).count()
     }
 
     /// The GPU context.

@@ -289,6 +289,13 @@ impl State {
         loop {
             let req = match pending.take() {
                 Some(r) => r,
+                // Idle: compile a pipeline prewarm queued (OpenGL's device is this thread's alone),
+                // then look for a request again.
+                None if self.renderer.compile_deferred() => match rx.try_recv() {
+                    Ok(r) => r,
+                    Err(TryRecvError::Empty) => continue,
+                    Err(TryRecvError::Disconnected) => return,
+                },
                 None => match rx.recv_timeout(Duration::from_secs(3600)) {
                     Ok(r) => r,
                     Err(RecvTimeoutError::Timeout) => continue,
@@ -425,8 +432,9 @@ impl State {
         }
         if let Some((_, gm)) = &self.material {
             // The pipeline this scene needs is compiled at its first draw; the variant for the
-            // light on the other side of the normal (shadow rays or none) is compiled ahead on
-            // another thread, so dragging the light through the zenith does not wait for one.
+            // light on the other side of the normal (shadow rays or none) is compiled ahead (on
+            // another thread, or on this one when it is idle on OpenGL, whose device one thread
+            // must own), so dragging the light through the zenith does not wait for one.
             let f = gm.features();
             let shape = req.scene.shape;
             self.renderer.prewarm(vec![

@@ -165,3 +165,67 @@ fn reports_a_missing_adapter() {
         Some(Event::NoAdapter(_))
     ));
 }
+
+/// Switch the worker through `presets` of the library (all of them when empty), each with the
+/// light on either side of the normal (each scene's pipeline and the other shadow variant's), and
+/// wait for each request's frames; panics on any other event (a stopped render thread).
+fn switch_through(test: &str, presets: &[&str]) {
+    let Some(w) = ready_worker(test) else {
+        return;
+    };
+    let mut generation = 100;
+    for (path, text) in lodestone_tests::presets() {
+        if !presets.is_empty() && !presets.iter().any(|p| path.ends_with(&format!("/{p}.ron"))) {
+            continue;
+        }
+        let m = Material::from_ron(&text).unwrap_or_else(|e| panic!("{path}: {e}"));
+        let image = lodestone_tests::prepare(&path, &m)
+            .surface
+            .driver
+            .image()
+            .map(|t| t.image.clone());
+        for light in [direction(0.8, 1.0), direction(0.0, 0.0)] {
+            generation += 1;
+            let mut r = request(generation, 1);
+            r.material = Arc::new(m.clone());
+            r.image = image.clone();
+            r.scene.light = light;
+            r.size = [24, 16];
+            w.request(r);
+            // Served when the truth's ray has come back at full size.
+            loop {
+                match w.wait(Duration::from_secs(600)) {
+                    Some(Event::Frame(f))
+                        if f.generation == generation
+                            && f.mode == ViewMode::Truth
+                            && f.scale == 1.0
+                            && f.samples == 1 =>
+                    {
+                        break;
+                    }
+                    Some(Event::Frame(_)) => {}
+                    other => panic!("{path}: unexpected {other:?}"),
+                }
+            }
+        }
+    }
+    drop(w);
+}
+
+/// Switching between presets whose pipelines are the largest (transfer curves, an image driver)
+/// never stops the render thread. On OpenGL the device is this thread's alone: a pipeline
+/// compiled on another thread beside a frame held the context lock past wgpu's one-second wait,
+/// and the thread stopped on a panic (with Mesa's shader cache cold or disabled,
+/// `MESA_SHADER_CACHE_DISABLE=true`: switching from cobblestones to moss stopped it).
+#[test]
+fn switching_presets_never_stops_the_render_thread() {
+    switch_through("the preset switching test", &["cobblestones", "moss"]);
+}
+
+/// The same through every preset of the library (about 15 minutes on llvmpipe with Mesa's shader
+/// cache disabled).
+#[test]
+#[ignore = "long: every preset's pipelines"]
+fn switching_every_preset_never_stops_the_render_thread() {
+    switch_through("the every-preset switching test", &[]);
+}
