@@ -170,6 +170,9 @@ pub enum DeviceSource {
 const PASS_BUDGET: Duration = Duration::from_millis(60);
 /// Smallest resolution scale.
 const MIN_SCALE: f32 = 1.0 / 16.0;
+/// How long the render thread waits for a request before it compiles a pipeline queued ahead of
+/// use (OpenGL: [`Renderer::compile_deferred`]).
+const IDLE_BEFORE_COMPILE: Duration = Duration::from_secs(2);
 
 impl Worker {
     /// Start the worker. `repaint` is called after every event (wakes the UI).
@@ -289,13 +292,19 @@ impl State {
         loop {
             let req = match pending.take() {
                 Some(r) => r,
-                // Idle: compile a pipeline prewarm queued (OpenGL's device is this thread's alone),
-                // then look for a request again.
-                None if self.renderer.compile_deferred() => match rx.try_recv() {
-                    Ok(r) => r,
-                    Err(TryRecvError::Empty) => continue,
-                    Err(TryRecvError::Disconnected) => return,
-                },
+                // Idle with pipelines prewarm queued (OpenGL's device is this thread's alone):
+                // once no request has come for a moment, compile one, then look again. The wait
+                // keeps a quick switch of presets from queueing behind a compile it does not need.
+                None if self.renderer.deferred_count() > 0 => {
+                    match rx.recv_timeout(IDLE_BEFORE_COMPILE) {
+                        Ok(r) => r,
+                        Err(RecvTimeoutError::Timeout) => {
+                            self.renderer.compile_deferred();
+                            continue;
+                        }
+                        Err(RecvTimeoutError::Disconnected) => return,
+                    }
+                }
                 None => match rx.recv_timeout(Duration::from_secs(3600)) {
                     Ok(r) => r,
                     Err(RecvTimeoutError::Timeout) => continue,
