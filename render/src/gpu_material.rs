@@ -83,7 +83,7 @@ const _: () = assert!(
 
 /// The uniform wave table: the waves as uploaded in the data buffer (k.x, k.y, amplitude, phase at
 /// the camera target), zero-padded to [`WAVE_TABLE_LEN`] (all zero without a noise driver).
-pub(crate) fn wave_table(data: &[f32], params: &MaterialParams) -> Vec<[f32; 4]> {
+fn wave_table(data: &[f32], params: &MaterialParams) -> Vec<[f32; 4]> {
     let mut table = vec![[0.0f32; 4]; WAVE_TABLE_LEN];
     let first = params.waves_offset as usize;
     let n = (params.wave_count as usize).min(WAVE_TABLE_LEN);

@@ -32,7 +32,7 @@ use std::f64::consts::TAU;
 
 /// Offsets (in f32 units) of each table in the material's data buffer.
 #[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct Layout {
+struct Layout {
     waves: u32,
     color_table: u32,
     transfer_table: u32,
@@ -42,14 +42,14 @@ pub(crate) struct Layout {
     transfer_poly: u32,
 }
 
-pub(crate) fn push_table(data: &mut Vec<f32>, t: &PreconvolvedTable) -> u32 {
+fn push_table(data: &mut Vec<f32>, t: &PreconvolvedTable) -> u32 {
     let off = data.len() as u32;
     data.extend(t.texels.iter().flatten());
     off
 }
 
 /// Knots, then per segment and channel 4 coefficients (degree ≤ 3), then left and right tails.
-pub(crate) fn push_poly(data: &mut Vec<f32>, p: &PiecewisePoly, channels: &[usize]) -> u32 {
+fn push_poly(data: &mut Vec<f32>, p: &PiecewisePoly, channels: &[usize]) -> u32 {
     let off = data.len() as u32;
     data.extend(p.knots.iter().map(|k| *k as f32));
     for seg in 0..p.segments() {
@@ -70,7 +70,7 @@ pub(crate) fn push_poly(data: &mut Vec<f32>, p: &PiecewisePoly, channels: &[usiz
 /// Slots per level in the image's level table (WGSL `IMAGE_LEVEL_SLOTS`).
 pub const IMAGE_LEVEL_SLOTS: usize = 7;
 
-pub(crate) fn push_image(
+fn push_image(
     data: &mut Vec<f32>,
     base: &mut MaterialParams,
     tiled: &TiledImage,
@@ -428,7 +428,7 @@ pub fn material_data_for(
 
 /// The offset of `rule`: the already uploaded `shared` rule's when it is the same rule, else
 /// `rule` appended ([`push_rule`]) and marked as `name`.
-pub(crate) fn shared_or_pushed(
+fn shared_or_pushed(
     data: &mut Vec<f32>,
     rule: SlopeRule,
     (shared, offset): (SlopeRule, u32),
@@ -446,7 +446,7 @@ pub(crate) fn shared_or_pushed(
 
 /// Append a slope rule's nodes ([`SlopeRule::nodes`]: x, y, weight per node) and return its
 /// offset.
-pub(crate) fn push_rule(data: &mut Vec<f32>, rule: SlopeRule) -> u32 {
+fn push_rule(data: &mut Vec<f32>, rule: SlopeRule) -> u32 {
     let offset = data.len() as u32;
     for (z, w) in rule.nodes() {
         data.extend([z.x as f32, z.y as f32, *w as f32]);
@@ -456,7 +456,7 @@ pub(crate) fn push_rule(data: &mut Vec<f32>, rule: SlopeRule) -> u32 {
 
 /// The noise driver the octave march sums, when the march is fast, the scene has relief and σ_h > 0:
 /// what the bound grid and the field table are built from (`None` otherwise).
-pub(crate) fn marched_noise(prepared: &Evaluator, features: FeatureSet) -> Option<&SumOfSines> {
+fn marched_noise(prepared: &Evaluator, features: FeatureSet) -> Option<&SumOfSines> {
     let s = &prepared.surface;
     let DriverField::Noise(noise) = &s.driver else {
         return None;
@@ -517,7 +517,7 @@ pub fn push_march_tables(
 /// Append the bound grid of `noise` around `centre` to `d` (the octave march's skips;
 /// [`lodestone_core::scene::bound_grid`]): the pyramid's levels one after the other, `[lo, hi]` per
 /// cell, in coordinates relative to `centre` like the waves.
-pub(crate) fn push_bound_grid(noise: &SumOfSines, centre: DVec2, d: &mut MaterialData) {
+fn push_bound_grid(noise: &SumOfSines, centre: DVec2, d: &mut MaterialData) {
     let Some(grid) = BoundGrid::around(noise, centre, GPU_GRID_CELLS) else {
         return;
     };
@@ -544,7 +544,7 @@ pub const GPU_FIELD_CELLS: usize = 512;
 /// Append the field table of `noise` around `centre` to `d` (the octave march's steps near the
 /// surface; [`lodestone_core::scene::field_grid`]), its origin relative to `centre` like the waves
 /// and its error bounds widened by [`FIELD_MARGIN_F32`] for the f32 arithmetic.
-pub(crate) fn push_field_grid(noise: &SumOfSines, centre: DVec2, d: &mut MaterialData) {
+fn push_field_grid(noise: &SumOfSines, centre: DVec2, d: &mut MaterialData) {
     let Some(field) = FieldGrid::around(noise, centre, GPU_FIELD_CELLS) else {
         return;
     };

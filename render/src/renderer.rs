@@ -350,7 +350,7 @@ impl Renderer {
     }
 
     /// The pipeline, parameters and bind group of one view pass (`frame` and `list_len` left at 0).
-    pub(crate) fn view_pass(
+    fn view_pass(
         &self,
         target: &ViewTarget,
         material: &GpuMaterial,
@@ -439,7 +439,7 @@ impl Renderer {
     }
 
     /// Whether cut rays are traced again ([`Renderer::set_retry_cut`] on a software adapter).
-    pub(crate) fn retries_cut(&self) -> bool {
+    fn retries_cut(&self) -> bool {
         self.retry_cut && self.ctx.is_software()
     }
 
@@ -462,7 +462,7 @@ impl Renderer {
     }
 
     /// Zero the target's count of cut loops and its work per pixel.
-    pub(crate) fn clear_cut(&self, target: &ViewTarget) {
+    fn clear_cut(&self, target: &ViewTarget) {
         let mut enc = self
             .ctx
             .device
@@ -475,7 +475,7 @@ impl Renderer {
     }
 
     /// Write `params` and dispatch one view pass over `rows` rows of the target's width.
-    pub(crate) fn dispatch_view(
+    fn dispatch_view(
         &self,
         target: &ViewTarget,
         pipeline: &wgpu::ComputePipeline,

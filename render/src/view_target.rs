@@ -50,7 +50,7 @@ pub struct ViewTarget {
 
 /// Map a finished `MAP_READ` buffer and copy it out as 32-bit words (waits for the GPU).
 /// A storage buffer the view shader writes and the CPU can clear and read back.
-pub(crate) fn readable_storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
+fn readable_storage(device: &wgpu::Device, label: &str, size: u64) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {
         label: Some(label),
         size,
@@ -82,10 +82,7 @@ pub(crate) fn read_words(
     map_words(ctx, &readback)
 }
 
-pub(crate) fn map_words(
-    ctx: &GpuContext,
-    readback: &wgpu::Buffer,
-) -> Result<Vec<u32>, RenderError> {
+fn map_words(ctx: &GpuContext, readback: &wgpu::Buffer) -> Result<Vec<u32>, RenderError> {
     let slice = readback.slice(..);
     let (tx, rx) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| {
@@ -107,7 +104,7 @@ pub(crate) fn map_words(
 
 /// The `order` (8 bytes an entry) and `scratch` (16 bytes an entry) buffers of a planned ground
 /// truth for `entries` entries.
-pub(crate) fn plan_buffers(device: &wgpu::Device, entries: usize) -> (wgpu::Buffer, wgpu::Buffer) {
+fn plan_buffers(device: &wgpu::Device, entries: usize) -> (wgpu::Buffer, wgpu::Buffer) {
     let make = |label, bytes: u64, usage| {
         device.create_buffer(&wgpu::BufferDescriptor {
             label: Some(label),
@@ -263,7 +260,7 @@ impl ViewTarget {
     }
 
     /// Copy one of the target's per-pixel `vec4<f32>` buffers back.
-    pub(crate) fn read_buffer(
+    fn read_buffer(
         &self,
         renderer: &impl AsRef<GpuContext>,
         buffer: &wgpu::Buffer,
