@@ -227,7 +227,7 @@ impl Evaluator {
     }
 
     /// `σ_h·g′(f)`: how far a unit of the driver's gradient tilts the surface.
-    pub(crate) fn transfer_slope(&self, f: f64) -> f64 {
+    pub(super) fn transfer_slope(&self, f: f64) -> f64 {
         self.surface.sigma_h * self.material.heights.transfer.derivative(f)
     }
 

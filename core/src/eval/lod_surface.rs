@@ -26,7 +26,7 @@ impl Evaluator {
     /// Lipschitz constant of f̄ ([`DriverField::lod_lipschitz_along`]: for the noise the attenuated
     /// components `Σ|a_i| g_i 2π|k_i·d̂|`; for the image its levels' constants, or under
     /// [`March::Reference`] the explicit surface's, as before #15; ∂ḡ/∂m = E[g′] ≤ max|g′|).
-    pub(crate) fn lod_rate(&self, d: DVec3, fp: Footprint) -> f64 {
+    pub(super) fn lod_rate(&self, d: DVec3, fp: Footprint) -> f64 {
         let dxy = DVec2::new(d.x, d.y);
         let r = dxy.length();
         let mut k = 0.0;

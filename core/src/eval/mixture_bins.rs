@@ -137,7 +137,7 @@ impl Evaluator {
     /// and `wi` in the frame of the footprint's mean normal (for Λ), `cfg`'s in the macro frame
     /// (for the slope averages, which live in world slope space), `sun_visible` the shadow ray's
     /// verdict and `frame` the tangent frame, as [`Evaluator::filtered`] takes them.
-    pub(crate) fn filtered_bins(
+    pub(super) fn filtered_bins(
         &self,
         loc: &FootprintStats,
         cfg: &FootprintQuery,

@@ -16,7 +16,7 @@ impl Evaluator {
 
     /// [`Evaluator::naive`] with the directional light's visibility `sun_visible` (the pixel's
     /// shadow ray) and the tangent frame `frame` (world axes, for slope colour and environment).
-    pub(crate) fn naive_lit(
+    pub(super) fn naive_lit(
         &self,
         cfg: &FootprintQuery,
         sun_visible: f64,

@@ -67,7 +67,7 @@ impl Evaluator {
 }
 
 /// 1 when the light is above the horizon of both the macro surface and the facet n, else 0.
-pub(crate) fn lit(cfg: &FootprintQuery, n: DVec3) -> f64 {
+pub(super) fn lit(cfg: &FootprintQuery, n: DVec3) -> f64 {
     if cfg.wi.z > 0.0 && n.dot(cfg.wi) > 0.0 {
         1.0
     } else {

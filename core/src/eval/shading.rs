@@ -55,12 +55,12 @@ impl SlopeShading {
 
 impl Evaluator {
     /// `C_s(n)` of the slope term (0 without one).
-    pub(crate) fn slope_color_at(&self, n: DVec3) -> [f64; 3] {
+    pub(super) fn slope_color_at(&self, n: DVec3) -> [f64; 3] {
         self.slope_color.as_ref().map_or([0.0; 3], |c| c.sample(n))
     }
 
     /// Environment irradiance at unit normal n (0 without an environment).
-    pub(crate) fn environment_at(&self, n: DVec3) -> [f64; 3] {
+    pub(super) fn environment_at(&self, n: DVec3) -> [f64; 3] {
         self.environment
             .as_ref()
             .map_or([0.0; 3], |e| e.irradiance(n))
@@ -85,7 +85,7 @@ impl Evaluator {
     /// (world slope space) on the material's weighted polar nodes ([`visible_slope_nodes`], [`crate::microfacet::visible_slopes::slope_rule`]):
     /// C_s and the environment are averaged *jointly* with the clamped cosine, so no independence of
     /// colour and shading is assumed ([HNPN14 Sec. 5.2] assumes it; the joint average costs the same).
-    pub(crate) fn visible_shading(
+    pub(super) fn visible_shading(
         &self,
         mean: DVec2,
         sigma: &SlopeCov,
@@ -104,7 +104,7 @@ impl Evaluator {
 
     /// The sums [`Evaluator::visible_shading`] divides: each input weighted by the node's
     /// visible projected area, and the sum of those weights, on the rule of order `points`.
-    pub(crate) fn visible_shading_sums(
+    pub(super) fn visible_shading_sums(
         &self,
         mean: DVec2,
         sigma: &SlopeCov,
@@ -177,7 +177,7 @@ impl Evaluator {
 
     /// The specular lobes per channel of one facet of unit normal n (the base lobe's
     /// [`BaseBrdf::specular_with`], or a measured BRDF's fitted lobes there).
-    pub(crate) fn facet_specular(&self, n: DVec3, wo: DVec3, wi: DVec3) -> [f64; 3] {
+    pub(super) fn facet_specular(&self, n: DVec3, wo: DVec3, wi: DVec3) -> [f64; 3] {
         let Some(m) = &self.measured else {
             let b = &self.material.brdf;
             return [b.specular_with(n, wo, wi, SlopeCov::default()); 3];
@@ -272,7 +272,7 @@ pub const FACET_FRAME_MAX: f64 = 2.0;
 /// underestimates the convex `1/(n·h)⁴` by 15–50% at 45–75°). At grazing views the slope-space
 /// lobe is 2–3× too bright: a facet tilted toward the viewer sees ωo far less obliquely than the
 /// macro frame does. 1 for an untilted footprint (s̄ = 0, Σ = 0); at most [`FACET_FRAME_MAX`].
-pub(crate) fn facet_frame_factor(
+pub(super) fn facet_frame_factor(
     sigma_lobe: f64,
     mean: DVec2,
     sigma: &SlopeCov,

@@ -18,7 +18,7 @@ impl Evaluator {
 
     /// [`Evaluator::view_independent`] with the sun's visibility and the tangent frame, as
     /// [`Evaluator::naive`]'s.
-    pub(crate) fn view_independent_lit(
+    pub(super) fn view_independent_lit(
         &self,
         cfg: &FootprintQuery,
         sun_visible: f64,

@@ -219,7 +219,7 @@ pub fn front_columns(n: usize) -> usize {
 }
 
 /// The two azimuth nodes around `dir` and the weight of the second (periodic over π).
-pub(crate) fn azimuth_coordinate(dir: DVec2) -> (usize, usize, f64) {
+pub(in crate::eval) fn azimuth_coordinate(dir: DVec2) -> (usize, usize, f64) {
     let phi = dir.y.atan2(dir.x).rem_euclid(PI);
     let x = if phi.is_finite() {
         phi / PI * TABLE_AZIMUTHS as f64
@@ -233,7 +233,7 @@ pub(crate) fn azimuth_coordinate(dir: DVec2) -> (usize, usize, f64) {
 
 /// The ν nodes `n, n + 1` around `nu` and the weight of `n + 1`, linear in ln ν and clamped to
 /// the end nodes (NaN and ν ≤ 0 read the first node, +∞ the last).
-pub(crate) fn nu_coordinate(nu: f64) -> (usize, f64) {
+pub(in crate::eval) fn nu_coordinate(nu: f64) -> (usize, f64) {
     let nv = if nu > 0.0 && nu.is_finite() {
         ((nu / NU_MIN).ln() / NU_RATIO.ln()).clamp(0.0, (TABLE_NUS - 1) as f64)
     } else if nu > 0.0 {

@@ -154,7 +154,7 @@ impl SlopeWeights {
 /// `E[C·cos] = Σ_j M_j C_j S_j.cos / Σ_j M_j W_j`, returned as an effective colour per channel
 /// times an effective shading (the sun's terms use `cos`, `cs_cos`; the environment's `env`,
 /// `cs_env`: disjoint, so one [`SlopeShading`] carries both).
-pub(crate) struct JointInputs {
+pub(in crate::eval) struct JointInputs {
     /// Colour terms under the sun.
     pub sun: Affine,
     /// Colour terms under the environment.
@@ -198,7 +198,7 @@ fn weighted_terms(
 }
 
 /// [`JointInputs`] from the slope buckets, the sun's and the environment's masses and colour terms.
-pub(crate) fn joint_inputs(
+pub(in crate::eval) fn joint_inputs(
     buckets: &[(SlopeShading, f64); SLOPE_NODES],
     sun: (&[f64; SLOPE_NODES], &[Affine; SLOPE_NODES]),
     env: (&[f64; SLOPE_NODES], &[Affine; SLOPE_NODES]),
@@ -250,7 +250,7 @@ impl Evaluator {
     /// nodes ([`crate::eval::masking::slope_weights::joint_inputs`]). Unnormalised, with each bucket's
     /// weight.
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn visible_shading_buckets(
+    pub(in crate::eval) fn visible_shading_buckets(
         &self,
         mean: DVec2,
         sigma: &SlopeCov,
@@ -278,7 +278,7 @@ impl Evaluator {
     /// (`filtering.slope_masking`), for drivers other than the noise (an image's process is not a
     /// sum of sinusoids, [`Evaluator::slope_masking`] is `None`), at the normal (no azimuth) and
     /// when no slope is unresolved along the view.
-    pub(crate) fn slope_weights(
+    pub(in crate::eval) fn slope_weights(
         &self,
         footprint: Footprint,
         mean: DVec2,
